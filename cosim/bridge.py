@@ -1,0 +1,560 @@
+"""The bridge: a continuous beam of 7-DOF elements with supports, damping, modes and statics.
+
+Global DOF ``7 * node + k`` with ``k`` in :data:`cosim.element.DOF_NAMES` order;
+nodes are numbered from the first abutment (x = 0) along +x.
+
+Sign convention used everywhere (tested): the vertical displacement of a deck
+point at lateral position ``y`` is ``w(x, y) = w_S(x) + (y - y_S) theta_x(x)``,
+so a positive twist lifts the left side (y > y_S) and a downward load on the
+left twists the deck negatively.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+import scipy.linalg
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .element import (
+    DOF_INDEX,
+    DOF_NAMES,
+    ELEMENT_DOFS,
+    FIELD_INDEX,
+    NODE_DOFS,
+    DeckRow,
+    deck_row_values,
+    element_matrices,
+    field_matrix,
+    shear_parameters,
+)
+from .errors import ConfigError, ModelError
+from .section import Material, SectionProperties
+
+__all__ = [
+    "DOF_NAMES",
+    "SUPPORT_PRESETS",
+    "MODE_KINDS",
+    "RayleighDamping",
+    "ExplicitDamping",
+    "PointLoad",
+    "BridgeModel",
+    "ModalResult",
+    "StaticResult",
+    "build_bridge",
+    "support_dofs",
+]
+
+SUPPORT_PRESETS: dict[str, tuple[str, ...]] = {
+    "free": (),
+    "fork": ("v", "w", "theta_x"),
+    "warping-restrained": ("v", "w", "theta_x", "psi"),
+    "pinned": ("u", "v", "w", "theta_x"),
+    # The paper's rigid end section: the end face tied to a reference point whose
+    # translations and twist are held. With theta_x = 0 the centroid and shear
+    # centre translations coincide, and the rigid face also stops warping.
+    "rigid-end": ("u", "v", "w", "theta_x", "psi"),
+    "fixed": DOF_NAMES,
+}
+
+# Groups of DOFs whose strain energy names a mode's kind.
+MODE_KINDS: dict[str, tuple[str, ...]] = {
+    "axial": ("u",),
+    "lateral": ("v", "theta_z"),
+    "vertical": ("w", "theta_y"),
+    "torsion": ("theta_x", "psi"),
+}
+_PURE_KIND_SHARE = 0.75
+
+SupportSpec = Union[str, Sequence[str]]
+
+
+@dataclass(frozen=True)
+class RayleighDamping:
+    """Rayleigh damping ``C = alpha M + beta K`` from target ratios at two modes.
+
+    Args:
+        ratios: damping ratios (fraction of critical) at the two modes.
+        modes: two mode references: a 1-based mode number, or ``"<kind>-<n>"``
+            (the n-th mode of that kind, kind in vertical | lateral | torsion | axial).
+    """
+
+    ratios: tuple[float, float]
+    modes: tuple[Union[int, str], Union[int, str]]
+
+
+@dataclass(frozen=True)
+class ExplicitDamping:
+    """Rayleigh damping with explicit ``alpha`` (1/s) and ``beta`` (s)."""
+
+    alpha: float
+    beta: float
+
+
+@dataclass(frozen=True)
+class PointLoad:
+    """A vertical point load on the deck at (x, y) m; ``Fz`` in N, positive up."""
+
+    x: float
+    y: float
+    Fz: float
+
+
+def support_dofs(spec: SupportSpec) -> tuple[str, ...]:
+    """Resolve a support given as a preset name or a list of DOF names."""
+    if isinstance(spec, str):
+        if spec not in SUPPORT_PRESETS:
+            raise ConfigError(
+                f"unknown support preset {spec!r} (expected one of: {', '.join(SUPPORT_PRESETS)})"
+            )
+        return SUPPORT_PRESETS[spec]
+    names = tuple(spec)
+    for name in names:
+        if name not in DOF_INDEX:
+            raise ConfigError(f"unknown DOF {name!r} in a support (expected some of: {', '.join(DOF_NAMES)})")
+    return names
+
+
+@dataclass(frozen=True)
+class ModalResult:
+    """Natural frequencies and mode shapes (mass-normalised, full DOF vectors).
+
+    Attributes:
+        omega: circular frequencies, rad/s, ascending.
+        shapes: array (ndof, n): column j is mode j, ``shapes.T M shapes = I``.
+        energy_shares: dict kind -> array (n,) of strain-energy shares per DOF group.
+        kinds: kind of each mode ("vertical", "lateral", "torsion", "axial" or
+            "coupled <a>-<b>" when no group holds 75 % of the strain energy).
+        dominant: the DOF group with the largest share, per mode.
+        participation: dict direction -> effective modal mass fractions (n,)
+            for rigid translations along z ("vertical"), y ("lateral"), x
+            ("axial") and rotation about the shear-centre axis ("torsion").
+    """
+
+    omega: npt.NDArray[np.float64]
+    shapes: npt.NDArray[np.float64]
+    energy_shares: dict[str, npt.NDArray[np.float64]]
+    kinds: list[str]
+    dominant: list[str]
+    participation: dict[str, npt.NDArray[np.float64]]
+    bridge: "BridgeModel" = field(repr=False)
+
+    @property
+    def f_hz(self) -> npt.NDArray[np.float64]:
+        """Natural frequencies, Hz."""
+        return self.omega / (2.0 * np.pi)
+
+    def index_of(self, ref: Union[int, str]) -> int:
+        """0-based index of a mode reference (1-based number or ``"<kind>-<n>"``)."""
+        if isinstance(ref, (int, np.integer)) and not isinstance(ref, bool):
+            if not 1 <= ref <= len(self.omega):
+                raise ConfigError(f"mode {ref} does not exist (computed {len(self.omega)} modes)")
+            return int(ref) - 1
+        kind, _, number = str(ref).rpartition("-")
+        if kind not in MODE_KINDS or not number.isdigit() or int(number) < 1:
+            raise ConfigError(
+                f"mode reference {ref!r} must be a 1-based mode number or '<kind>-<n>' "
+                f"with kind in {', '.join(MODE_KINDS)}"
+            )
+        hits = [i for i, d in enumerate(self.dominant) if d == kind]
+        if len(hits) < int(number):
+            raise ConfigError(
+                f"mode reference {ref!r}: only {len(hits)} {kind} mode(s) among the first {len(self.omega)}"
+            )
+        return hits[int(number) - 1]
+
+    def field(self, mode: int, name: str, x: npt.ArrayLike, y: float = 0.0) -> npt.NDArray[np.float64]:
+        """Field ``name`` of mode ``mode`` (0-based) at positions x (see BridgeModel.field)."""
+        return self.bridge.field(self.shapes[:, mode], name, x, y=y)
+
+
+@dataclass(frozen=True)
+class StaticResult:
+    """Static displacements ``d`` (full DOF vector, m and rad) under given loads."""
+
+    d: npt.NDArray[np.float64]
+    bridge: "BridgeModel" = field(repr=False)
+
+    def deck_displacement(self, x: float, y: float) -> float:
+        """Vertical displacement of deck point (x, y), m, positive up."""
+        row = self.bridge.deck_point_row(x, y)
+        return float(row.values[0] @ self.d[row.dofs])
+
+    def field(self, name: str, x: npt.ArrayLike, y: float = 0.0) -> npt.NDArray[np.float64]:
+        """Field ``name`` at positions x (see :meth:`BridgeModel.field`)."""
+        return self.bridge.field(self.d, name, x, y=y)
+
+
+@dataclass(frozen=True, eq=False)
+class BridgeModel:
+    """An assembled bridge. Build it with :func:`build_bridge`; it never changes afterwards.
+
+    Attributes:
+        spans: span lengths, m.
+        nodes_x: node positions along the axis, m.
+        material, section: what every element is made of.
+        restrained: sorted global DOF indices held by supports.
+        K, M: full sparse stiffness (N/m, N, N m) and consistent mass (kg, kg m, kg m^2).
+        alpha, beta: Rayleigh coefficients in use (1/s, s); zero when undamped.
+    """
+
+    spans: tuple[float, ...]
+    nodes_x: npt.NDArray[np.float64]
+    material: Material
+    section: SectionProperties
+    supports: tuple[tuple[str, ...], ...]
+    restrained: npt.NDArray[np.int64]
+    K: sp.csr_matrix
+    M: sp.csr_matrix
+    alpha: float = 0.0
+    beta: float = 0.0
+    damping_note: str = "undamped"
+
+    # ----------------------------------------------------------------- sizes
+    @property
+    def length(self) -> float:
+        """Total length, m."""
+        return float(self.nodes_x[-1])
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.nodes_x)
+
+    @property
+    def n_elements(self) -> int:
+        return len(self.nodes_x) - 1
+
+    @property
+    def ndof(self) -> int:
+        return NODE_DOFS * len(self.nodes_x)
+
+    @cached_property
+    def free(self) -> npt.NDArray[np.int64]:
+        """Global indices of the unrestrained DOFs."""
+        mask = np.ones(self.ndof, dtype=bool)
+        mask[self.restrained] = False
+        return np.flatnonzero(mask)
+
+    @cached_property
+    def support_x(self) -> npt.NDArray[np.float64]:
+        """Positions of the support lines, m."""
+        return np.concatenate([[0.0], np.cumsum(self.spans)])
+
+    @cached_property
+    def _element_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per element: length, phi_y, phi_z."""
+        lengths = np.diff(self.nodes_x)
+        phis = np.array([shear_parameters(L, self.material, self.section) for L in lengths])
+        return lengths, phis[:, 0], phis[:, 1]
+
+    # ------------------------------------------------------- reduced matrices
+    @cached_property
+    def K_ff(self) -> sp.csc_matrix:
+        return self.K[self.free][:, self.free].tocsc()
+
+    @cached_property
+    def M_ff(self) -> sp.csc_matrix:
+        return self.M[self.free][:, self.free].tocsc()
+
+    @property
+    def C(self) -> sp.csr_matrix:
+        """Rayleigh damping matrix, full size (N s/m-type units)."""
+        return (self.alpha * self.M + self.beta * self.K).tocsr()
+
+    @cached_property
+    def _static_lu(self) -> spla.SuperLU:
+        return spla.splu(self.K_ff)
+
+    def expand(self, d_free: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """Full DOF vector(s) from free-DOF vector(s) (restrained DOFs are zero)."""
+        d_free = np.asarray(d_free)
+        out = np.zeros((self.ndof,) + d_free.shape[1:])
+        out[self.free] = d_free
+        return out
+
+    # -------------------------------------------------------------- location
+    def locate(self, x: float) -> tuple[int, float]:
+        """Element index and local coordinate xi in [0, 1] of axial position x (m)."""
+        if not (-1e-9 <= x <= self.length + 1e-9):
+            raise ModelError(f"x = {x} m is outside the bridge (0 to {self.length} m)")
+        e = int(np.searchsorted(self.nodes_x, x, side="right")) - 1
+        e = min(max(e, 0), self.n_elements - 1)
+        lengths = self._element_data[0]
+        xi = (x - self.nodes_x[e]) / lengths[e]
+        return e, float(min(max(xi, 0.0), 1.0))
+
+    def _element_dofs(self, e: int) -> npt.NDArray[np.int64]:
+        return np.arange(NODE_DOFS * e, NODE_DOFS * e + ELEMENT_DOFS)
+
+    def deck_point_row(self, x: float, y: float) -> DeckRow:
+        """Row mapping all bridge DOFs to the vertical displacement of deck point (x, y).
+
+        ``w(x, y) = w_S(x) + (y - y_S) theta_x(x)`` with bending and twist
+        interpolated by the element's own shape functions; ``values[1]`` and
+        ``values[2]`` are its first and second x-derivatives (1 and 1/m), as the
+        moving-contact kinematics need.
+        """
+        e, xi = self.locate(x)
+        lengths, phi_y, phi_z = self._element_data
+        values = deck_row_values(xi, lengths[e], phi_y[e], phi_z[e], y - self.section.y_s)
+        return DeckRow(dofs=self._element_dofs(e), values=values)
+
+    def field(
+        self, d: npt.NDArray[np.float64], name: str, x: npt.ArrayLike, y: float = 0.0, order: int = 0
+    ) -> npt.NDArray[np.float64]:
+        """Evaluate a field of the full DOF vector ``d`` at positions ``x`` (m).
+
+        ``name`` is one of u, v, w, theta_x, theta_y, theta_z (interpolated with
+        the element's shape functions), ``psi`` (= theta_x'), ``w_deck`` (the
+        deck point at lateral position ``y``), or ``bending_moment`` (M_y about
+        the centroidal y axis, N m, sagging positive: ``-E I_y theta_y'`` ...
+        with theta_y = -w' that is ``E I_y w''``).
+        """
+        xs = np.atleast_1d(np.asarray(x, dtype=float))
+        out = np.empty(len(xs))
+        lengths, phi_y, phi_z = self._element_data
+        for i, xv in enumerate(xs):
+            e, xi = self.locate(float(xv))
+            de = d[self._element_dofs(e)]
+            if name == "bending_moment":
+                n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + 1)[0]
+                # Sagging (tension at the bottom) positive: M = -E I_y theta_y' (+ the I_yz term).
+                out[i] = -(self.material.E * (self.section.I_y * n[FIELD_INDEX["theta_y"]]
+                                              - self.section.I_yz * n[FIELD_INDEX["theta_z"]])) @ de
+                continue
+            if name == "psi":
+                n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + 1)[0]
+                out[i] = n[FIELD_INDEX["theta_x"]] @ de
+                continue
+            n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order)[0]
+            if name == "w_deck":
+                out[i] = (n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]) @ de
+            elif name in FIELD_INDEX:
+                out[i] = n[FIELD_INDEX[name]] @ de
+            else:
+                raise ModelError(
+                    f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, psi, w_deck, bending_moment)"
+                )
+        return out
+
+    # ---------------------------------------------------------------- statics
+    def load_vector(self, loads: Sequence[PointLoad]) -> npt.NDArray[np.float64]:
+        """Consistent nodal force vector (full size, N and N m) of vertical point loads."""
+        f = np.zeros(self.ndof)
+        for load in loads:
+            self._check_on_deck(load.x, load.y)
+            row = self.deck_point_row(load.x, load.y)
+            np.add.at(f, row.dofs, load.Fz * row.values[0])
+        return f
+
+    def _check_on_deck(self, x: float, y: float) -> None:
+        y_min, y_max = self.section.deck_y
+        if not (0.0 <= x <= self.length):
+            raise ModelError(f"load at x = {x} m is off the bridge (0 to {self.length} m)")
+        if not (y_min - 1e-9 <= y <= y_max + 1e-9):
+            raise ModelError(f"load at y = {y} m is off the deck ({y_min} to {y_max} m)")
+
+    def static(self, loads: Sequence[PointLoad] = (), f: npt.NDArray[np.float64] | None = None) -> StaticResult:
+        """Static displacements under point loads (and/or a full force vector ``f``)."""
+        total = self.load_vector(loads)
+        if f is not None:
+            total = total + f
+        d_free = self._static_lu.solve(total[self.free])
+        if not np.all(np.isfinite(d_free)):
+            raise ModelError("static solve failed: the supports leave a mechanism (add restraints)")
+        return StaticResult(d=self.expand(d_free), bridge=self)
+
+    # ----------------------------------------------------------------- modes
+    def modes(self, count: int = 10) -> ModalResult:
+        """The ``count`` lowest natural modes (undamped), classified by strain energy."""
+        n_free = len(self.free)
+        if count < 1:
+            raise ConfigError("`count` must be >= 1")
+        count = min(count, n_free)
+        if n_free <= 3000:
+            w2, phi = scipy.linalg.eigh(
+                self.K_ff.toarray(), self.M_ff.toarray(), subset_by_index=(0, count - 1), driver="gvx"
+            )
+        else:  # large meshes: shift-invert Lanczos around zero
+            w2, phi = spla.eigsh(self.K_ff, k=count, M=self.M_ff, sigma=0.0, which="LM")
+            order = np.argsort(w2)
+            w2, phi = w2[order], phi[:, order]
+        # A mechanism shows up as an eigenvalue at round-off level compared with
+        # the stiffest element-level ratio K_ii / M_ii.
+        scale = float(np.max(self.K_ff.diagonal() / self.M_ff.diagonal()))
+        if w2[0] <= 1e-10 * scale:
+            raise ModelError(
+                "the bridge has a rigid-body mode: its supports leave it free to move "
+                "(for example no twist or no axial restraint anywhere)"
+            )
+        omega = np.sqrt(np.maximum(w2, 0.0))
+        # Normalise each mode so its largest deflection is positive (repeatable signs).
+        for j in range(phi.shape[1]):
+            k = np.argmax(np.abs(phi[:, j]))
+            if phi[k, j] < 0:
+                phi[:, j] *= -1.0
+        shapes = self.expand(phi)
+        shares, kinds, dominant = self._classify(shapes)
+        participation = self._participation(phi)
+        return ModalResult(omega, shapes, shares, kinds, dominant, participation, bridge=self)
+
+    @cached_property
+    def _group_masks(self) -> dict[str, npt.NDArray[np.bool_]]:
+        dof_kind = np.tile(np.arange(NODE_DOFS), self.n_nodes)
+        return {
+            kind: np.isin(dof_kind, [DOF_INDEX[n] for n in names]) for kind, names in MODE_KINDS.items()
+        }
+
+    def _classify(self, shapes: np.ndarray) -> tuple[dict[str, np.ndarray], list[str], list[str]]:
+        k_phi = self.K @ shapes
+        total = np.einsum("ij,ij->j", shapes, k_phi)
+        shares = {
+            kind: np.einsum("ij,ij->j", shapes[mask], k_phi[mask]) / total
+            for kind, mask in self._group_masks.items()
+        }
+        kinds, dominant = [], []
+        names = list(shares)
+        table = np.array([shares[k] for k in names])
+        for j in range(shapes.shape[1]):
+            order = np.argsort(table[:, j])[::-1]
+            top, second = names[order[0]], names[order[1]]
+            dominant.append(top)
+            if table[order[0], j] >= _PURE_KIND_SHARE:
+                kinds.append(top)
+            else:
+                a, b = sorted([top, second], key=list(MODE_KINDS).index)
+                kinds.append(f"coupled {a}-{b}")
+        return shares, kinds, dominant
+
+    def _participation(self, phi_free: np.ndarray) -> dict[str, np.ndarray]:
+        out = {}
+        dof_kind = np.tile(np.arange(NODE_DOFS), self.n_nodes)[self.free]
+        for direction, dof in (("vertical", "w"), ("lateral", "v"), ("axial", "u"), ("torsion", "theta_x")):
+            r = (dof_kind == DOF_INDEX[dof]).astype(float)
+            m_r = self.M_ff @ r
+            total = r @ m_r
+            # Mass-normalised shapes: effective mass = (phi^T M r)^2.
+            out[direction] = (phi_free.T @ m_r) ** 2 / total if total > 0 else np.zeros(phi_free.shape[1])
+        return out
+
+
+def _mesh(spans: Sequence[float], elements_per_span: Sequence[int]) -> np.ndarray:
+    xs = [0.0]
+    start = 0.0
+    for span, n in zip(spans, elements_per_span):
+        xs.extend(start + span * np.arange(1, n + 1) / n)
+        start += span
+    return np.array(xs)
+
+
+def _rayleigh(w1: float, w2: float, z1: float, z2: float) -> tuple[float, float]:
+    """alpha, beta with zeta(w) = alpha/(2w) + beta w/2 hitting (w1, z1) and (w2, z2)."""
+    a = np.array([[1.0 / (2.0 * w1), w1 / 2.0], [1.0 / (2.0 * w2), w2 / 2.0]])
+    alpha, beta = np.linalg.solve(a, [z1, z2])
+    return float(alpha), float(beta)
+
+
+def build_bridge(
+    spans: Sequence[float],
+    elements_per_span: Union[int, Sequence[int]],
+    material: Material,
+    section: SectionProperties,
+    supports: Sequence[SupportSpec],
+    damping: Union[RayleighDamping, ExplicitDamping, None] = None,
+) -> BridgeModel:
+    """Assemble a continuous beam bridge.
+
+    Args:
+        spans: span lengths, m (one per span, continuous over the inner supports).
+        elements_per_span: elements in each span (one number for all, or one per span).
+        material: the beam's material.
+        section: the cross-section constants.
+        supports: one entry per support line (``len(spans) + 1``): a preset
+            name from :data:`SUPPORT_PRESETS` or a list of DOF names to restrain.
+        damping: Rayleigh damping from two modes' ratios, explicit alpha/beta, or None.
+
+    Returns:
+        The assembled, immutable :class:`BridgeModel`.
+
+    Raises:
+        ConfigError: for inconsistent input.
+    """
+    spans = tuple(float(s) for s in spans)
+    if not spans or any(not s > 0 for s in spans):
+        raise ConfigError(f"`spans` must be one or more positive lengths (got {list(spans)})")
+    n_per = [int(elements_per_span)] * len(spans) if np.isscalar(elements_per_span) else list(elements_per_span)
+    if len(n_per) != len(spans) or any(n < 1 for n in n_per):
+        raise ConfigError("`elements_per_span` must be >= 1, one number or one per span")
+    if len(supports) != len(spans) + 1:
+        raise ConfigError(f"`supports` needs {len(spans) + 1} entries, one per support line (got {len(supports)})")
+    support_sets = tuple(support_dofs(s) for s in supports)
+
+    nodes_x = _mesh(spans, n_per)
+    n_nodes = len(nodes_x)
+    ndof = NODE_DOFS * n_nodes
+    lengths = np.diff(nodes_x)
+
+    # Element matrices depend only on the length: compute once per distinct length.
+    cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+    rows, cols, kv, mv = [], [], [], []
+    local = np.arange(ELEMENT_DOFS)
+    for e, L in enumerate(lengths):
+        key = round(float(L), 12)
+        if key not in cache:
+            cache[key] = element_matrices(float(L), material, section)
+        k_e, m_e = cache[key]
+        dofs = NODE_DOFS * e + local
+        rows.append(np.repeat(dofs, ELEMENT_DOFS))
+        cols.append(np.tile(dofs, ELEMENT_DOFS))
+        kv.append(k_e.ravel())
+        mv.append(m_e.ravel())
+    rows_a, cols_a = np.concatenate(rows), np.concatenate(cols)
+    K = sp.csr_matrix((np.concatenate(kv), (rows_a, cols_a)), shape=(ndof, ndof))
+    M = sp.csr_matrix((np.concatenate(mv), (rows_a, cols_a)), shape=(ndof, ndof))
+
+    support_nodes = np.concatenate([[0], np.cumsum(n_per)])
+    restrained = sorted(
+        {NODE_DOFS * int(node) + DOF_INDEX[name] for node, names in zip(support_nodes, support_sets) for name in names}
+    )
+    bridge = BridgeModel(
+        spans=spans,
+        nodes_x=nodes_x,
+        material=material,
+        section=section,
+        supports=support_sets,
+        restrained=np.array(restrained, dtype=np.int64),
+        K=K,
+        M=M,
+    )
+    if damping is None:
+        return bridge
+    if isinstance(damping, ExplicitDamping):
+        if damping.alpha < 0 or damping.beta < 0:
+            raise ConfigError("Rayleigh `alpha` and `beta` must be >= 0")
+        return _with_damping(bridge, damping.alpha, damping.beta, f"explicit alpha={damping.alpha:g}, beta={damping.beta:g}")
+    z1, z2 = damping.ratios
+    modal = bridge.modes(count=max(30, _max_mode_number(damping.modes)))
+    i1, i2 = modal.index_of(damping.modes[0]), modal.index_of(damping.modes[1])
+    if i1 == i2:
+        raise ConfigError(f"damping `modes` {damping.modes} name the same mode twice")
+    w1, w2 = modal.omega[i1], modal.omega[i2]
+    alpha, beta = _rayleigh(w1, w2, z1, z2)
+    note = (
+        f"Rayleigh: {z1:.3g} at mode {i1 + 1} ({modal.f_hz[i1]:.4g} Hz, {damping.modes[0]}), "
+        f"{z2:.3g} at mode {i2 + 1} ({modal.f_hz[i2]:.4g} Hz, {damping.modes[1]})"
+    )
+    return _with_damping(bridge, alpha, beta, note)
+
+
+def _max_mode_number(refs: Sequence[Union[int, str]]) -> int:
+    return max([int(r) for r in refs if isinstance(r, (int, np.integer))] + [1])
+
+
+def _with_damping(bridge: BridgeModel, alpha: float, beta: float, note: str) -> BridgeModel:
+    from dataclasses import replace
+
+    return replace(bridge, alpha=alpha, beta=beta, damping_note=note)
