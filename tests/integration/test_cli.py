@@ -1,0 +1,152 @@
+"""The command line, run as users run it: ``python -m cosim ...`` in a subprocess."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import cosim
+from cosim.cli import main
+
+REPO = Path(cosim.__file__).resolve().parents[1]
+PAPER_TEXT = (REPO / "cosim" / "scenarios" / "paper-double-tee.toml").read_text(encoding="utf-8")
+
+
+def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m cosim ARGS`` against this checkout."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env["MPLBACKEND"] = "Agg"
+    return subprocess.run(
+        [sys.executable, "-m", "cosim", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd or REPO,
+        env=env,
+        timeout=300,
+    )
+
+
+# --------------------------------------------------------------------------- help
+
+
+@pytest.mark.parametrize(
+    ("args", "mentions"),
+    [
+        ((), ["modes", "run", "docs/scenario.md", "examples:"]),
+        (("modes",), ["SCENARIO", "--count", "--json", "--plot", "examples:"]),
+        (("run",), ["SCENARIO", "--out", "paper-double-tee", "examples:"]),
+    ],
+    ids=["cosim", "modes", "run"],
+)
+def test_help_exits_zero_and_describes_options(args: tuple[str, ...], mentions: list[str]) -> None:
+    result = cosim_cli(*args, "--help")
+    assert result.returncode == 0, result.stderr
+    for word in mentions:
+        assert word in result.stdout, word
+
+
+def test_no_command_is_a_usage_error() -> None:
+    result = cosim_cli()
+    assert result.returncode == 2
+    assert "usage: cosim" in result.stderr
+
+
+def test_bad_option_value_is_a_usage_error() -> None:
+    result = cosim_cli("modes", "paper-double-tee", "--count", "0")
+    assert result.returncode == 2
+    assert "--count" in result.stderr
+    assert "Traceback" not in result.stderr
+
+
+# --------------------------------------------------------------------------- errors
+
+
+def test_malformed_scenario_exits_2_with_one_line(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text(PAPER_TEXT.replace("thickness = 0.25", "thickness = -0.25", 1), encoding="utf-8")
+    for command in ("modes", "run"):
+        result = cosim_cli(command, str(bad))
+        assert result.returncode == 2, result.stderr
+        assert "Traceback" not in result.stderr
+        lines = result.stderr.strip().splitlines()
+        assert lines == [f"cosim: error: {bad}: bridge.section.plates[0].thickness: must be > 0 (got -0.25)"]
+        assert result.stdout == ""
+
+
+def test_missing_scenario_file_exits_2(tmp_path: Path) -> None:
+    result = cosim_cli("modes", str(tmp_path / "missing.toml"))
+    assert result.returncode == 2
+    assert result.stderr.startswith(f"cosim: error: {tmp_path / 'missing.toml'}: no such scenario file")
+    assert "Traceback" not in result.stderr
+
+
+def test_main_returns_status_instead_of_exiting(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "typo.toml"
+    bad.write_text(PAPER_TEXT.replace("spans = [40.0]", "spanz = [40.0]", 1), encoding="utf-8")
+    assert main(["modes", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"cosim: error: {bad}: bridge.spanz: unknown key; did you mean \"spans\"?")
+    assert main(["--help"]) == 0
+    assert main(["frobnicate"]) == 2
+
+
+def test_unwritable_output_fails_before_the_work(tmp_path: Path) -> None:
+    result = cosim_cli("run", "--out", str(tmp_path / "no-such-dir" / "summary.json"))
+    assert result.returncode == 2
+    assert "does not exist" in result.stderr
+    assert result.stdout == ""
+
+
+# --------------------------------------------------------------------------- results
+
+
+def test_modes_json_is_parseable() -> None:
+    result = cosim_cli("modes", "paper-double-tee", "--json", "--count", "6")
+    assert result.returncode == 0, result.stderr
+    payload = json.loads(result.stdout)  # nothing but JSON on stdout
+    assert payload["scenario"] == "paper-double-tee"
+    modes = payload["modes"]
+    assert [m["n"] for m in modes] == [1, 2, 3, 4, 5, 6]
+    for mode in modes:
+        assert mode["f_hz"] > 0
+        assert isinstance(mode["kind"], str) and mode["kind"]
+        assert set(mode["participation"]) >= {"vertical", "lateral", "torsion"}
+    f = [m["f_hz"] for m in modes]
+    assert f == sorted(f)
+    assert modes[0]["kind"] == "vertical"
+    for key in ("A", "I_y", "I_z", "J", "I_w", "A_sy", "A_sz", "y_s", "z_s"):
+        assert key in payload["section"]
+    assert payload["damping"]["alpha"] > 0 and payload["damping"]["beta"] > 0
+
+
+def test_modes_table_and_plot(tmp_path: Path) -> None:
+    png = tmp_path / "modes.png"
+    result = cosim_cli("modes", "paper-double-tee-asymmetric", "--count", "3", "--plot", str(png))
+    assert result.returncode == 0, result.stderr
+    for word in ("I_w", "shear centre", "f [Hz]", "vertical", "torsion"):
+        assert word in result.stdout
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_run_default_scenario_writes_summary(tmp_path: Path) -> None:
+    out = tmp_path / "summary.json"
+    result = cosim_cli("run", "--out", str(out))
+    assert result.returncode == 0, result.stderr
+    assert "not implemented yet" in result.stdout
+    summary = json.loads(out.read_text(encoding="utf-8"))
+    assert summary["scenario"] == "paper-double-tee"
+    assert len(summary["modes"]) == 10
+    cases = {case["name"]: case for case in summary["static"]}
+    axis, edge = cases["axis"], cases["left_edge"]
+    assert axis["load"] == {"x": 20.0, "y": 0.0, "Fz": -100e3, "span": 1}
+    assert edge["load"]["y"] == pytest.approx(6.655)
+    # A downward load deflects the deck down; on the left edge it twists the
+    # deck negatively, so the left edge goes down more than the axis.
+    assert axis["sensors"]["node1"] < 0
+    assert edge["sensors"]["node2"] < edge["sensors"]["node3"] < edge["sensors"]["node1"] < 0
+    assert axis["sensors"]["node2"] == pytest.approx(axis["sensors"]["node1"], rel=1e-3)
