@@ -30,6 +30,7 @@ from .element import (
     deck_row_values,
     element_matrices,
     field_matrix,
+    shape_coefficients,
     shear_parameters,
 )
 from .errors import ConfigError, ModelError
@@ -303,42 +304,83 @@ class BridgeModel:
         values = deck_row_values(xi, lengths[e], phi_y[e], phi_z[e], y - self.section.y_s)
         return DeckRow(dofs=self._element_dofs(e), values=values)
 
-    def field(
-        self, d: npt.NDArray[np.float64], name: str, x: npt.ArrayLike, y: float = 0.0, order: int = 0
-    ) -> npt.NDArray[np.float64]:
-        """Evaluate a field of the full DOF vector ``d`` at positions ``x`` (m).
+    @cached_property
+    def _deck_coefficients(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per element: polynomial coefficients of w and theta_x (n_el, 14, 4), and lengths."""
+        lengths, phi_y, phi_z = self._element_data
+        c_w = np.empty((self.n_elements, ELEMENT_DOFS, 4))
+        c_t = np.empty_like(c_w)
+        for e in range(self.n_elements):
+            c = shape_coefficients(float(lengths[e]), float(phi_y[e]), float(phi_z[e]))
+            c_w[e], c_t[e] = c[FIELD_INDEX["w"]], c[FIELD_INDEX["theta_x"]]
+        return c_w, c_t, lengths
+
+    def deck_rows(
+        self, x: npt.ArrayLike, y: npt.ArrayLike
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]:
+        """Vectorised :meth:`deck_point_row` for q points on the deck.
+
+        Returns ``dofs`` (q, 14) and ``values`` (q, 3, 14): the rows of
+        ``w(x, y)`` and of its first and second x-derivatives.
+        """
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        c_w, c_t, lengths = self._deck_coefficients
+        e = np.clip(np.searchsorted(self.nodes_x, x, side="right") - 1, 0, self.n_elements - 1)
+        L = lengths[e]
+        xi = np.clip((x - self.nodes_x[e]) / L, 0.0, 1.0)
+        one, zero = np.ones_like(xi), np.zeros_like(xi)
+        powers = np.stack(
+            [
+                np.stack([one, xi, xi * xi, xi**3], axis=-1),
+                np.stack([zero, one, 2 * xi, 3 * xi * xi], axis=-1) / L[:, None],
+                np.stack([zero, zero, 2 * one, 6 * xi], axis=-1) / (L * L)[:, None],
+            ],
+            axis=1,
+        )  # (q, 3, 4)
+        lever = (y - self.section.y_s)[:, None, None]
+        values = np.einsum("qdp,qop->qod", c_w[e], powers) + lever * np.einsum("qdp,qop->qod", c_t[e], powers)
+        dofs = NODE_DOFS * e[:, None] + np.arange(ELEMENT_DOFS)[None, :]
+        return dofs, values
+
+    def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0) -> DeckRow:
+        """Row mapping the element DOFs at ``x`` (m) to a field value.
 
         ``name`` is one of u, v, w, theta_x, theta_y, theta_z (interpolated with
         the element's shape functions), ``psi`` (= theta_x'), ``w_deck`` (the
-        deck point at lateral position ``y``), or ``bending_moment`` (M_y about
-        the centroidal y axis, N m, sagging positive: ``-E I_y theta_y'`` ...
-        with theta_y = -w' that is ``E I_y w''``).
+        vertical displacement of the deck point at lateral position ``y``, m),
+        or ``bending_moment`` (vertical bending moment about the centroidal y
+        axis, N m, sagging positive: ``M = -E (I_y theta_y' - I_yz theta_z')``,
+        which is ``E I_y w''`` for Euler-Bernoulli bending). ``order`` adds
+        x-derivatives. Only ``values[0]`` of the returned row is filled.
         """
+        e, xi = self.locate(x)
+        lengths, phi_y, phi_z = self._element_data
+        extra = 1 if name in ("bending_moment", "psi") else 0
+        n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra)[0]
+        if name == "bending_moment":
+            row = -self.material.E * (self.section.I_y * n[FIELD_INDEX["theta_y"]] - self.section.I_yz * n[FIELD_INDEX["theta_z"]])
+        elif name == "psi":
+            row = n[FIELD_INDEX["theta_x"]]
+        elif name == "w_deck":
+            row = n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]
+        elif name in FIELD_INDEX:
+            row = n[FIELD_INDEX[name]]
+        else:
+            raise ModelError(
+                f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, psi, w_deck, bending_moment)"
+            )
+        return DeckRow(dofs=self._element_dofs(e), values=row[None, :])
+
+    def field(
+        self, d: npt.NDArray[np.float64], name: str, x: npt.ArrayLike, y: float = 0.0, order: int = 0
+    ) -> npt.NDArray[np.float64]:
+        """Evaluate field ``name`` (see :meth:`field_row`) of the full DOF vector ``d`` at positions ``x`` (m)."""
         xs = np.atleast_1d(np.asarray(x, dtype=float))
         out = np.empty(len(xs))
-        lengths, phi_y, phi_z = self._element_data
         for i, xv in enumerate(xs):
-            e, xi = self.locate(float(xv))
-            de = d[self._element_dofs(e)]
-            if name == "bending_moment":
-                n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + 1)[0]
-                # Sagging (tension at the bottom) positive: M = -E I_y theta_y' (+ the I_yz term).
-                out[i] = -(self.material.E * (self.section.I_y * n[FIELD_INDEX["theta_y"]]
-                                              - self.section.I_yz * n[FIELD_INDEX["theta_z"]])) @ de
-                continue
-            if name == "psi":
-                n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + 1)[0]
-                out[i] = n[FIELD_INDEX["theta_x"]] @ de
-                continue
-            n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order)[0]
-            if name == "w_deck":
-                out[i] = (n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]) @ de
-            elif name in FIELD_INDEX:
-                out[i] = n[FIELD_INDEX[name]] @ de
-            else:
-                raise ModelError(
-                    f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, psi, w_deck, bending_moment)"
-                )
+            row = self.field_row(name, float(xv), y, order)
+            out[i] = row.values[0] @ d[row.dofs]
         return out
 
     # ---------------------------------------------------------------- statics

@@ -1,0 +1,147 @@
+"""Traffic seen by the bridge: which vehicles are where, how fast, at a given time.
+
+A traffic source answers :meth:`TrafficSource.frame` for the time of every
+beam step: the vehicles in the simulation with their contact point ``x``
+(m, on the bridge axis), speed ``v`` and acceleration ``a`` along +x (negative
+when driving towards x = 0), lateral offset ``y`` and model. Vehicles that
+appear are put on the deck at static equilibrium; vehicles that disappear are
+gone. :class:`ScriptedTraffic` is the source for runs without SUMO.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from .errors import ConfigError
+from .vehicles import VehicleModel
+
+
+@dataclass(frozen=True)
+class TrafficFrame:
+    """Vehicles present at one instant (parallel arrays, one entry per vehicle).
+
+    Attributes:
+        ids: vehicle identifiers.
+        x: contact-point positions along the axis, m.
+        v: speeds along +x, m/s.
+        a: accelerations along +x, m/s^2.
+        y: lateral offsets of the wheel paths, m.
+        models: the vehicle model of each vehicle.
+    """
+
+    ids: tuple[str, ...]
+    x: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    a: npt.NDArray[np.float64]
+    y: npt.NDArray[np.float64]
+    models: tuple[VehicleModel, ...]
+
+
+class TrafficSource(Protocol):
+    """Anything that can say where the vehicles are at time ``t`` (s)."""
+
+    def frame(self, t: float) -> TrafficFrame: ...
+
+
+@dataclass(frozen=True)
+class ScriptedVehicle:
+    """A vehicle driven by a script.
+
+    Args:
+        id: name used in results.
+        model: the vehicle model.
+        y: lateral offset of the wheel path from the bridge axis, m.
+        speed: constant speed, m/s (> 0), used when ``profile`` is empty.
+        entry_time: time at which the contact point reaches the deck's start, s.
+        direction: +1 drives along +x (enters at x = 0), -1 along -x (enters at x = L).
+        profile: optional ((t, speed), ...) pairs, t relative to ``entry_time``;
+            speed is linear between them and held after the last.
+    """
+
+    id: str
+    model: VehicleModel
+    y: float
+    speed: float
+    entry_time: float = 0.0
+    direction: int = 1
+    profile: tuple[tuple[float, float], ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.direction not in (1, -1):
+            raise ConfigError(f"vehicle {self.id}: `direction` must be +1 or -1 (got {self.direction!r})")
+        if not self.profile and not self.speed > 0:
+            raise ConfigError(f"vehicle {self.id}: `speed` must be > 0 m/s (got {self.speed!r})")
+        if self.entry_time < 0:
+            raise ConfigError(f"vehicle {self.id}: `entry_time` must be >= 0 s (got {self.entry_time!r})")
+        if self.profile:
+            ts = [p[0] for p in self.profile]
+            if ts[0] != 0.0 or any(b <= a for a, b in zip(ts, ts[1:])):
+                raise ConfigError(f"vehicle {self.id}: `profile` times must start at 0 and increase")
+            if any(p[1] < 0 for p in self.profile):
+                raise ConfigError(f"vehicle {self.id}: `profile` speeds must be >= 0 m/s")
+
+    def distance(self, tau: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distance travelled since entry, speed and acceleration at ``tau = t - entry_time``."""
+        tau = np.asarray(tau, dtype=float)
+        if not self.profile:
+            return self.speed * tau, np.full_like(tau, self.speed), np.zeros_like(tau)
+        ts = np.array([p[0] for p in self.profile])
+        vs = np.array([p[1] for p in self.profile])
+        acc = np.append(np.diff(vs) / np.diff(ts), 0.0)  # constant speed after the last point
+        dist_at = np.concatenate([[0.0], np.cumsum((vs[:-1] + vs[1:]) / 2 * np.diff(ts))])
+        k = np.clip(np.searchsorted(ts, tau, side="right") - 1, 0, len(ts) - 1)
+        dt = tau - ts[k]
+        return dist_at[k] + vs[k] * dt + 0.5 * acc[k] * dt**2, vs[k] + acc[k] * dt, acc[k]
+
+
+@dataclass(frozen=True)
+class ScriptedTraffic:
+    """Scripted vehicles on a bridge of length ``length`` m; each is present while on the deck."""
+
+    vehicles: tuple[ScriptedVehicle, ...]
+    length: float
+    _ids: frozenset = field(init=False, repr=False, default=frozenset())
+
+    def __post_init__(self) -> None:
+        ids = [v.id for v in self.vehicles]
+        if len(set(ids)) != len(ids):
+            raise ConfigError("vehicle ids must be unique")
+        object.__setattr__(self, "_ids", frozenset(ids))
+
+    def frame(self, t: float) -> TrafficFrame:
+        ids, xs, vs, as_, ys, models = [], [], [], [], [], []
+        for veh in self.vehicles:
+            tau = t - veh.entry_time
+            if tau < 0:
+                continue
+            s, v, a = veh.distance(tau)
+            if s > self.length:
+                continue
+            x = float(s) if veh.direction > 0 else self.length - float(s)
+            ids.append(veh.id)
+            xs.append(x)
+            vs.append(veh.direction * float(v))
+            as_.append(veh.direction * float(a))
+            ys.append(veh.y)
+            models.append(veh.model)
+        return TrafficFrame(
+            ids=tuple(ids), x=np.array(xs), v=np.array(vs), a=np.array(as_), y=np.array(ys), models=tuple(models)
+        )
+
+    def end_time(self) -> float:
+        """Time when the last vehicle leaves the deck, s (inf if one stops on it)."""
+        latest = 0.0
+        for veh in self.vehicles:
+            if not veh.profile:
+                latest = max(latest, veh.entry_time + self.length / veh.speed)
+                continue
+            if veh.profile[-1][1] <= 0:
+                return float("inf")
+            t_last, _ = veh.profile[-1]
+            s_last, _, _ = veh.distance(t_last)
+            remaining = max(self.length - float(s_last), 0.0)
+            latest = max(latest, veh.entry_time + t_last + remaining / veh.profile[-1][1])
+        return latest
