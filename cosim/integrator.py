@@ -47,50 +47,67 @@ class Scheme:
         return cls("hht", alpha, (1.0 - alpha) ** 2 / 4.0, 0.5 - alpha)
 
 
-def newmark_predict(
-    d: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, scheme: Scheme
-) -> tuple[np.ndarray, np.ndarray]:
-    """Newmark predictors: d_{n+1} = d* + beta dt^2 a_{n+1}, v_{n+1} = v* + gamma dt a_{n+1}."""
-    d_star = d + dt * v + (0.5 - scheme.beta) * dt * dt * a
-    v_star = v + (1.0 - scheme.gamma) * dt * a
-    return d_star, v_star
-
-
 class DirectBasis:
-    """All free DOFs of the FE model; banded Cholesky of the effective matrix."""
+    """All free DOFs of the FE model; banded Cholesky of the effective matrix.
+
+    Holds what the compiled step needs: the banded factor, K and M (CSR), the
+    Rayleigh coefficients, and the dense inverse of
+    the effective matrix, whose element blocks give the Woodbury capacitance
+    matrix without one solve per vehicle (n^2 doubles: the basis refuses
+    models above ``MAX_DIRECT_DOFS`` and points to the modal basis).
+    """
 
     name = "direct"
+    MAX_DIRECT_DOFS = 6000
 
     def __init__(self, bridge: BridgeModel, dt: float, scheme: Scheme) -> None:
         self.bridge = bridge
         self.n = len(bridge.free)
+        if self.n > self.MAX_DIRECT_DOFS:
+            raise ConfigError(
+                f"the direct basis keeps a dense {self.n} x {self.n} inverse; above {self.MAX_DIRECT_DOFS} "
+                "free DOFs use `basis = \"modal\"` (or fewer elements)"
+            )
         self.K = bridge.K_ff.tocsr()
         self.M = bridge.M_ff.tocsr()
-        self.C = (bridge.alpha * self.M + bridge.beta * self.K).tocsr()
+        for mat in (self.K, self.M):  # drop explicit zeros the assembly left (CSR work is per entry)
+            mat.eliminate_zeros()
+        self.ray_alpha, self.ray_beta = float(bridge.alpha), float(bridge.beta)
+        self.C = (self.ray_alpha * self.M + self.ray_beta * self.K).tocsr()
         c = 1.0 + scheme.alpha
         a_eff = (self.M + c * (scheme.gamma * dt * self.C + scheme.beta * dt * dt * self.K)).tocoo()
-        self._cb = self._banded_cholesky(a_eff)
+        self.bandwidth = int(np.max(np.abs(a_eff.col - a_eff.row)))
+        # Hand-off to LAPACK's banded Cholesky (pbtrf): the bridge is a beam, so its
+        # matrices are banded, and a banded factor is the cheapest exact solve.
+        self.cholesky_band = scipy.linalg.cholesky_banded(self._band(a_eff), lower=False)
+        bw = self.bandwidth
+        # The same factor stored by rows (row j holds U[j, j:j+bw+1]) for the compiled solve.
+        self.cholesky_rows = np.zeros((self.n, bw + 1))
+        for k in range(bw + 1):
+            self.cholesky_rows[: self.n - k, k] = self.cholesky_band[bw - k, k:]
         self.n_factorizations = 1
         self.n_solves = 0
-        # Full DOF -> reduced index; restrained DOFs point at a zero slot (index n).
-        self._reduced_index = np.full(bridge.ndof, self.n, dtype=np.int64)
-        self._reduced_index[bridge.free] = np.arange(self.n)
+        self.inverse = scipy.linalg.cho_solve_banded((self.cholesky_band, False), np.eye(self.n), check_finite=False)
+        # Full DOF -> reduced index, -1 for restrained DOFs.
+        self.reduced_map = np.full(bridge.ndof, -1, dtype=np.int64)
+        self.reduced_map[bridge.free] = np.arange(self.n)
 
-    @staticmethod
-    def _banded_cholesky(a: sp.coo_matrix) -> np.ndarray:
+    def _band(self, a: sp.coo_matrix) -> np.ndarray:
+        """Upper band storage (LAPACK): ab[bw + i - j, j] = A[i, j] for i <= j."""
         upper = a.row <= a.col
         rows, cols, vals = a.row[upper], a.col[upper], a.data[upper]
-        bandwidth = int(np.max(cols - rows))
-        ab = np.zeros((bandwidth + 1, a.shape[0]))
-        np.add.at(ab, (bandwidth + rows - cols, cols), vals)
-        # Hand-off to LAPACK's banded Cholesky (pbtrf/pbtrs): the bridge is a beam, so
-        # its matrices are banded, and a banded factor is the cheapest exact solve.
-        return scipy.linalg.cholesky_banded(ab, lower=False)
+        ab = np.zeros((self.bandwidth + 1, self.n))
+        np.add.at(ab, (self.bandwidth + rows - cols, cols), vals)
+        return ab
+
+    def reduced_index(self, dofs: np.ndarray) -> np.ndarray:
+        """Reduced indices of full DOFs (-1 where restrained)."""
+        return self.reduced_map[dofs]
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """A^{-1} b for a vector or a matrix of right-hand sides."""
         self.n_solves += 1
-        return scipy.linalg.cho_solve_banded((self._cb, False), b, check_finite=False)
+        return scipy.linalg.cho_solve_banded((self.cholesky_band, False), b, check_finite=False)
 
     def internal_force(self, d: np.ndarray, v: np.ndarray) -> np.ndarray:
         """C v + K d."""
@@ -100,7 +117,8 @@ class DirectBasis:
         """Dense reduced rows (q, n) from element rows (dofs (q, 14), values (q, 14))."""
         q = dofs.shape[0]
         out = np.zeros((q, self.n + 1))
-        np.add.at(out, (np.repeat(np.arange(q), dofs.shape[1]), self._reduced_index[dofs].ravel()), values.ravel())
+        idx = np.where(self.reduced_map[dofs] >= 0, self.reduced_map[dofs], self.n)
+        np.add.at(out, (np.repeat(np.arange(q), dofs.shape[1]), idx.ravel()), values.ravel())
         return out[:, : self.n]
 
     def full(self, x: np.ndarray) -> np.ndarray:
@@ -146,20 +164,20 @@ class ModalBasis:
         self.omega = modal.omega[keep]
         self.n = int(keep.sum())
         self.bridge = bridge
-        self.phi_full = modal.shapes[:, keep]  # (ndof, n)
+        self.phi_full = np.ascontiguousarray(modal.shapes[:, keep])  # (ndof, n)
         if modal_damping is not None:
             self.c_diag = 2.0 * modal_damping * self.omega
         else:
             self.c_diag = bridge.alpha + bridge.beta * self.omega**2
         self.k_diag = self.omega**2
         c = 1.0 + scheme.alpha
-        self._a_inv = 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
+        self.a_inv_diag = 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
         self.n_factorizations = 1
         self.n_solves = 0
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         self.n_solves += 1
-        return b * (self._a_inv if b.ndim == 1 else self._a_inv[:, None])
+        return b * (self.a_inv_diag if b.ndim == 1 else self.a_inv_diag[:, None])
 
     def internal_force(self, d: np.ndarray, v: np.ndarray) -> np.ndarray:
         return self.c_diag * v + self.k_diag * d

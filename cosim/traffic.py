@@ -40,10 +40,34 @@ class TrafficFrame:
     models: tuple[VehicleModel, ...]
 
 
-class TrafficSource(Protocol):
-    """Anything that can say where the vehicles are at time ``t`` (s)."""
+@dataclass(frozen=True)
+class TrafficBlock:
+    """Vehicles over K consecutive beam steps: one fleet, kinematics per step.
 
-    def frame(self, t: float) -> TrafficFrame: ...
+    Attributes:
+        ids, models: the vehicles (q).
+        x, v, a: arrays (K, q): contact point (m), speed and acceleration along +x.
+            A vehicle whose x lies outside [0, L] at a step is off the deck then
+            (on the approach road, rigid ground).
+        y: lateral offsets (q,), m.
+    """
+
+    ids: tuple[str, ...]
+    models: tuple[VehicleModel, ...]
+    x: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    a: npt.NDArray[np.float64]
+    y: npt.NDArray[np.float64]
+
+    @classmethod
+    def from_frame(cls, frame: TrafficFrame) -> "TrafficBlock":
+        return cls(frame.ids, frame.models, frame.x[None, :], frame.v[None, :], frame.a[None, :], frame.y)
+
+
+class TrafficSource(Protocol):
+    """Anything that can say where the vehicles are at the times of a block of steps (s)."""
+
+    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock: ...
 
 
 @dataclass(frozen=True)
@@ -94,7 +118,9 @@ class ScriptedVehicle:
         dist_at = np.concatenate([[0.0], np.cumsum((vs[:-1] + vs[1:]) / 2 * np.diff(ts))])
         k = np.clip(np.searchsorted(ts, tau, side="right") - 1, 0, len(ts) - 1)
         dt = tau - ts[k]
-        return dist_at[k] + vs[k] * dt + 0.5 * acc[k] * dt**2, vs[k] + acc[k] * dt, acc[k]
+        before = tau < 0  # on the approach: the entry speed, held
+        dist = np.where(before, vs[0] * tau, dist_at[k] + vs[k] * dt + 0.5 * acc[k] * dt**2)
+        return dist, np.where(before, vs[0], vs[k] + acc[k] * dt), np.where(before, 0.0, acc[k])
 
 
 @dataclass(frozen=True)
@@ -111,24 +137,37 @@ class ScriptedTraffic:
             raise ConfigError("vehicle ids must be unique")
         object.__setattr__(self, "_ids", frozenset(ids))
 
+    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock:
+        """The vehicles on the deck at any of ``times`` (s), with their kinematics at each."""
+        times = np.asarray(times, dtype=float)
+        n = len(self.vehicles)
+        s = np.empty((len(times), n))
+        v = np.empty_like(s)
+        a = np.empty_like(s)
+        for j, veh in enumerate(self.vehicles):
+            s[:, j], v[:, j], a[:, j] = veh.distance(times - veh.entry_time)
+        entered = times[:, None] >= np.array([veh.entry_time for veh in self.vehicles])[None, :]
+        s = np.where(entered, s, np.minimum(s, -1e-9))  # not yet entered: still before the deck
+        on = entered & (s <= self.length)
+        present = np.flatnonzero(on.any(axis=0))
+        direction = np.array([self.vehicles[j].direction for j in present], dtype=float)
+        s, v, a = s[:, present], v[:, present], a[:, present]
+        x = np.where(direction > 0, s, self.length - s)
+        return TrafficBlock(
+            ids=tuple(self.vehicles[j].id for j in present),
+            models=tuple(self.vehicles[j].model for j in present),
+            x=x, v=direction * v, a=direction * a,
+            y=np.array([self.vehicles[j].y for j in present], dtype=float),
+        )
+
     def frame(self, t: float) -> TrafficFrame:
-        ids, xs, vs, as_, ys, models = [], [], [], [], [], []
-        for veh in self.vehicles:
-            tau = t - veh.entry_time
-            if tau < 0:
-                continue
-            s, v, a = veh.distance(tau)
-            if s > self.length:
-                continue
-            x = float(s) if veh.direction > 0 else self.length - float(s)
-            ids.append(veh.id)
-            xs.append(x)
-            vs.append(veh.direction * float(v))
-            as_.append(veh.direction * float(a))
-            ys.append(veh.y)
-            models.append(veh.model)
+        """The vehicles on the deck at time ``t`` (s)."""
+        b = self.block(np.array([t]))
+        on = (b.x[0] >= 0) & (b.x[0] <= self.length)
+        keep = np.flatnonzero(on)
         return TrafficFrame(
-            ids=tuple(ids), x=np.array(xs), v=np.array(vs), a=np.array(as_), y=np.array(ys), models=tuple(models)
+            ids=tuple(b.ids[j] for j in keep), x=b.x[0, keep], v=b.v[0, keep], a=b.a[0, keep], y=b.y[keep],
+            models=tuple(b.models[j] for j in keep),
         )
 
     def end_time(self) -> float:
