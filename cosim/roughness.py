@@ -104,7 +104,7 @@ def iso8608_profile(
     x_start: float,
     x_end: float,
     path_y: Sequence[float] = (0.0,),
-    dx: float = 0.05,
+    dx: float = 0.01,
 ) -> RoadProfile:
     """Random ISO 8608 profiles covering ``[x_start, x_end]`` (m), one per wheel path.
 
@@ -115,7 +115,8 @@ def iso8608_profile(
         x_start, x_end: range of x to cover, m.
         path_y: lateral offsets of the wheel paths, m; each gets an
             independent profile (drawn in this order from the one seed).
-        dx: grid spacing, m (must resolve N_MAX: dx <= 1 / (2 N_MAX)).
+        dx: grid spacing, m; the default puts 10 points on the shortest
+            wavelength (0.1 m), so linear interpolation between them is accurate.
     """
     if not x_end > x_start:
         raise ConfigError("road profile range must have x_end > x_start")
