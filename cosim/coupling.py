@@ -54,9 +54,11 @@ class BlockReport:
     """
 
     ids: tuple[str, ...]
+    models: tuple[VehicleModel, ...]
     x: npt.NDArray[np.float64]
     y: npt.NDArray[np.float64]
     v: npt.NDArray[np.float64]
+    a: npt.NDArray[np.float64]
     on_deck: npt.NDArray[np.bool_]
     contact_force: npt.NDArray[np.float64]
     body_displacement: npt.NDArray[np.float64]
@@ -226,7 +228,8 @@ class CoupledSystem:
             raise ModelError(f"the solution diverged at t = {self.t:.6g} s (non-finite bridge acceleration)")
         self.t += K * self.dt
         self.n_steps += K
-        return BlockReport(block.ids, block.x, block.y, block.v, out_on, out_contact, out_bu, out_ba, out_sens)
+        return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out_on, out_contact, out_bu,
+                           out_ba, out_sens)
 
     def step(self, frame: TrafficFrame) -> BlockReport:
         """Advance one step; ``frame`` describes the vehicles at ``t + dt``."""

@@ -12,6 +12,9 @@ Conventions shared by both bases:
   tyre force (the last two are the HHT ``F_n`` of each vehicle).
 * ``kind``: 0 moving force, 1 quarter-car (rigid contact), 2 tyre quarter-car.
 * Contact rows: element ``e`` and local values (3, 14) of w, w_x, w_xx.
+
+The block loops release the GIL, so a log writer thread can encode and write
+one block while the next is being computed.
 """
 from __future__ import annotations
 
@@ -194,7 +197,7 @@ def _csr_matvec_add(indptr, indices, data, x, out, scale):
         out[i] += scale * s
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def direct_block(cb, k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat, ray_a, ray_b, ainv, red_idx,
                  nodes_x, cw, ct, y_s, length,
                  dt, beta, gamma, alpha,
@@ -368,7 +371,7 @@ def _record(step, q, elems, contact, vstate, lifted, counters, out_contact, out_
 
 
 # ------------------------------------------------------------ modal basis
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def modal_block(phi, c_diag, k_diag, a_inv,
                 nodes_x, cw, ct, y_s, length,
                 dt, beta, gamma, alpha,

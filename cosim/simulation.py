@@ -11,13 +11,13 @@ import csv
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Protocol, Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from .bridge import BridgeModel
-from .coupling import CoupledSystem
+from .coupling import BlockReport, CoupledSystem
 from .errors import ConfigError
 from .integrator import Scheme, make_basis
 from .roughness import RoadProfile
@@ -85,6 +85,9 @@ class SimulationResult:
         liftoff_steps: vehicle-steps with a negative contact force.
         factorizations: effective-matrix factorisations done (1 per run).
         steps: time steps taken; wall_time: s.
+        sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
+        contact_force_range: (min, max) contact force per vehicle while on the deck, N.
+        max_on_deck: most vehicles on the deck at once.
     """
 
     t: npt.NDArray[np.float64]
@@ -97,6 +100,10 @@ class SimulationResult:
     steps: int = 0
     wall_time: float = 0.0
     info: dict = field(default_factory=dict)
+    sensor_min: dict[str, float] = field(default_factory=dict)
+    sensor_max: dict[str, float] = field(default_factory=dict)
+    contact_force_range: dict[str, tuple[float, float]] = field(default_factory=dict)
+    max_on_deck: int = 0
 
     def vehicle(self, vehicle_id: str) -> dict[str, npt.NDArray[np.float64]]:
         """The samples of one vehicle, column name -> array."""
@@ -120,6 +127,72 @@ class SimulationResult:
                 writer.writerow([repr(float(v)) for v in row])
 
 
+class BlockObserver(Protocol):
+    """Anything that wants to see every block of steps as it is computed (a log writer, a collector)."""
+
+    def on_block(self, times: npt.NDArray[np.float64], keep: npt.NDArray[np.bool_], report: BlockReport) -> None: ...
+
+
+class _Collector:
+    """Accumulates the sampled histories into a :class:`SimulationResult` (memory grows with the run)."""
+
+    COLUMNS = ("t", "vehicle", "x", "y", "v", "contact_force", "body_displacement", "body_acceleration")
+
+    def __init__(self, n_sensors: int) -> None:
+        self.t_parts = [np.zeros(1)]  # sample 0: at rest
+        self.s_parts = [np.zeros((1, n_sensors))]
+        self.vehicle_ids: list[str] = []
+        self.index_of: dict[str, int] = {}
+        self.table: dict[str, list[np.ndarray]] = {k: [] for k in self.COLUMNS}
+
+    def on_block(self, times, keep, report) -> None:
+        self.t_parts.append(times[keep])
+        self.s_parts.append(report.sensors[keep])
+        if not report.ids:
+            return
+        for vid in report.ids:
+            if vid not in self.index_of:
+                self.index_of[vid] = len(self.vehicle_ids)
+                self.vehicle_ids.append(vid)
+        rows, cols = np.nonzero(report.on_deck & keep[:, None])
+        vidx = np.array([self.index_of[v] for v in report.ids], dtype=np.int64)
+        tab = self.table
+        tab["t"].append(times[rows])
+        tab["vehicle"].append(vidx[cols].astype(float))
+        tab["x"].append(report.x[rows, cols])
+        tab["y"].append(report.y[cols])
+        tab["v"].append(report.v[rows, cols])
+        tab["contact_force"].append(report.contact_force[rows, cols])
+        tab["body_displacement"].append(report.body_displacement[rows, cols])
+        tab["body_acceleration"].append(report.body_acceleration[rows, cols])
+
+
+class _Extremes:
+    """Running extremes for summaries, in constant memory whatever the run's length."""
+
+    def __init__(self, names: Sequence[str]) -> None:
+        self.names = list(names)
+        self.s_min = np.zeros(len(names))
+        self.s_max = np.zeros(len(names))
+        self.force: dict[str, list[float]] = {}
+        self.max_on_deck = 0
+
+    def on_block(self, times, keep, report) -> None:
+        if len(report.sensors):
+            self.s_min = np.minimum(self.s_min, report.sensors.min(axis=0))
+            self.s_max = np.maximum(self.s_max, report.sensors.max(axis=0))
+        if not report.ids:
+            return
+        self.max_on_deck = max(self.max_on_deck, int(report.on_deck.sum(axis=1).max()))
+        on = report.on_deck.any(axis=0)
+        masked_min = np.where(report.on_deck, report.contact_force, np.inf).min(axis=0)
+        masked_max = np.where(report.on_deck, report.contact_force, -np.inf).max(axis=0)
+        for j in np.flatnonzero(on):
+            lo_hi = self.force.setdefault(report.ids[j], [np.inf, -np.inf])
+            lo_hi[0] = min(lo_hi[0], float(masked_min[j]))
+            lo_hi[1] = max(lo_hi[1], float(masked_max[j]))
+
+
 def simulate(
     bridge: BridgeModel,
     traffic: TrafficSource,
@@ -130,6 +203,8 @@ def simulate(
     output_every: int = 1,
     progress: Callable[[float], None] | None = None,
     block_steps: int = 200,
+    observers: Sequence[BlockObserver] = (),
+    collect: bool = True,
 ) -> SimulationResult:
     """Simulate ``duration`` seconds of traffic on the bridge.
 
@@ -143,6 +218,9 @@ def simulate(
         output_every: sample every this many steps.
         progress: called with the fraction done after every block of steps.
         block_steps: steps handed to the compiled loop at once.
+        observers: also shown every block (e.g. a log writer), in order.
+        collect: keep the sampled histories in the result; without it memory
+            stays constant however long the run (extremes are still reported).
     """
     if not duration > 0:
         raise ConfigError(f"`duration` must be > 0 s (got {duration})")
@@ -155,11 +233,9 @@ def simulate(
         sensors=tuple((s.x, s.y, s.quantity) for s in sensors),
     )
     n_steps = int(round(duration / solver.dt))
-    t_parts, s_parts = [np.zeros(1)], [np.zeros((1, len(sensors)))]  # sample 0: at rest
-    vehicle_ids: list[str] = []
-    index_of: dict[str, int] = {}
-    columns = ("t", "vehicle", "x", "y", "v", "contact_force", "body_displacement", "body_acceleration")
-    table: dict[str, list[np.ndarray]] = {k: [] for k in columns}
+    collector = _Collector(len(sensors)) if collect else None
+    extremes = _Extremes([s.name for s in sensors])
+    watchers: list = [extremes] + ([collector] if collector else []) + list(observers)
     started = time.perf_counter()
     done = 0
     while done < n_steps:
@@ -168,30 +244,19 @@ def simulate(
         times = steps * solver.dt
         report = system.advance(traffic.block(times))
         keep = steps % output_every == 0
-        t_parts.append(times[keep])
-        s_parts.append(report.sensors[keep])
-        if report.ids:
-            for vid in report.ids:
-                if vid not in index_of:
-                    index_of[vid] = len(vehicle_ids)
-                    vehicle_ids.append(vid)
-            rows, cols = np.nonzero(report.on_deck & keep[:, None])
-            vidx = np.array([index_of[v] for v in report.ids], dtype=np.int64)
-            table["t"].append(times[rows])
-            table["vehicle"].append(vidx[cols].astype(float))
-            table["x"].append(report.x[rows, cols])
-            table["y"].append(report.y[cols])
-            table["v"].append(report.v[rows, cols])
-            table["contact_force"].append(report.contact_force[rows, cols])
-            table["body_displacement"].append(report.body_displacement[rows, cols])
-            table["body_acceleration"].append(report.body_acceleration[rows, cols])
+        for w in watchers:
+            w.on_block(times, keep, report)
         done += k
         if progress is not None:
             progress(done / n_steps)
-    vehicle_table = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in table.items()}
-    vehicle_table["vehicle"] = vehicle_table["vehicle"].astype(np.int64)
-    t_out = np.concatenate(t_parts)
-    s_out = np.concatenate(s_parts)
+    if collector is not None:
+        vehicle_table = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in collector.table.items()}
+        vehicle_table["vehicle"] = vehicle_table["vehicle"].astype(np.int64)
+        t_out = np.concatenate(collector.t_parts)
+        s_out = np.concatenate(collector.s_parts)
+        vehicle_ids = collector.vehicle_ids
+    else:
+        vehicle_table, t_out, s_out, vehicle_ids = {}, np.zeros(0), np.zeros((0, len(sensors))), list(extremes.force)
     return SimulationResult(
         t=t_out,
         sensors={s.name: s_out[:, i].copy() for i, s in enumerate(sensors)},
@@ -203,4 +268,8 @@ def simulate(
         steps=system.n_steps,
         wall_time=time.perf_counter() - started,
         info={"basis": basis.name, "n_reduced": basis.n, "scheme": scheme.name, "dt": solver.dt},
+        sensor_min=dict(zip(extremes.names, extremes.s_min.tolist())),
+        sensor_max=dict(zip(extremes.names, extremes.s_max.tolist())),
+        contact_force_range={k: (v[0], v[1]) for k, v in extremes.force.items()},
+        max_on_deck=extremes.max_on_deck,
     )

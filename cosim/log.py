@@ -1,0 +1,444 @@
+"""MCAP logs: topics and schemas (one place), a crash-safe recorder, and a reader.
+
+Every message is JSON with a JSON Schema, so Foxglove and the ``mcap`` CLI can
+read the logs. Log times are integer nanoseconds of *simulated* time. The
+scenario, the resolved parameters, section constants, frequencies and every
+input file are stored as attachments and metadata, so a log alone is enough
+to re-run.
+
+The writer (:class:`LogRecorder`) is a context manager: whatever ends the run
+(normal end, Ctrl-C, an exception) a final status message is written and the
+file is finished with its summary and index. A process killed outright
+leaves the chunks already flushed; :func:`read_log` reads those and says the
+file is truncated. Logs are parsed, never evaluated or unpickled.
+"""
+from __future__ import annotations
+
+import io
+import json
+import os
+import queue
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any, Iterable, Iterator
+
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap.stream_reader import StreamReader
+from mcap.records import Attachment, Channel, Footer, Header, Message, Metadata
+from mcap.writer import CompressionType, Writer
+import numpy as np
+import orjson
+
+from . import __version__
+from .errors import LogError
+
+PROFILE = "cosim"
+TOPIC_SENSORS = "/cosim/sensors"
+TOPIC_VEHICLES = "/cosim/vehicles"
+TOPIC_EVENTS = "/cosim/events"
+TOPIC_STATUS = "/cosim/status"
+TOPIC_TRAFFIC = "/cosim/traffic"
+
+STATUS_STATES = ("started", "running", "finished", "interrupted", "error")
+EVENT_KINDS = ("entered", "left", "liftoff", "touchdown")
+
+_NUMBER = {"type": "number"}
+
+
+def sensors_schema(names: Iterable[str]) -> dict[str, Any]:
+    """Schema of one sensor sample: ``t`` (s) plus one number per sensor (SI unit of its quantity)."""
+    props: dict[str, Any] = {"t": {"type": "number", "description": "simulated time, s"}}
+    for name in names:
+        props[name] = _NUMBER
+    return {"title": "cosim.SensorSample", "type": "object", "properties": props,
+            "required": ["t", *names], "additionalProperties": False}
+
+
+VEHICLE_ITEM = {
+    "type": "object",
+    "properties": {
+        "id": {"type": "string"},
+        "model": {"type": "string"},
+        "x": {"type": "number", "description": "contact point along the axis, m"},
+        "y": {"type": "number", "description": "lateral offset, m"},
+        "speed": {"type": "number", "description": "along +x, m/s"},
+        "acceleration": {"type": "number", "description": "along +x, m/s^2"},
+        "body_displacement": {"type": "number", "description": "from static equilibrium, m"},
+        "body_acceleration": {"type": "number", "description": "m/s^2"},
+        "contact_force": {"type": "number", "description": "wheel on deck, compression positive, N"},
+    },
+    "required": ["id", "model", "x", "y", "speed", "acceleration", "body_displacement",
+                 "body_acceleration", "contact_force"],
+    "additionalProperties": False,
+}
+VEHICLES_SCHEMA = {
+    "title": "cosim.VehiclesOnDeck", "type": "object",
+    "properties": {"t": _NUMBER, "vehicles": {"type": "array", "items": VEHICLE_ITEM}},
+    "required": ["t", "vehicles"], "additionalProperties": False,
+}
+EVENTS_SCHEMA = {
+    "title": "cosim.TrafficEvent", "type": "object",
+    "properties": {"t": _NUMBER, "vehicle": {"type": "string"}, "event": {"enum": list(EVENT_KINDS)},
+                   "x": _NUMBER},
+    "required": ["t", "vehicle", "event"], "additionalProperties": False,
+}
+STATUS_SCHEMA = {
+    "title": "cosim.RunStatus", "type": "object",
+    "properties": {"t": _NUMBER, "state": {"enum": list(STATUS_STATES)}, "message": {"type": "string"},
+                   "progress": _NUMBER, "wall_time": _NUMBER},
+    "required": ["t", "state"], "additionalProperties": False,
+}
+TRAFFIC_SCHEMA = {
+    "title": "cosim.TrafficFrame", "type": "object",
+    "properties": {
+        "t": _NUMBER,
+        "ids": {"type": "array", "items": {"type": "string"}},
+        "x": {"type": "array", "items": _NUMBER},
+        "y": {"type": "array", "items": _NUMBER},
+        "speed": {"type": "array", "items": _NUMBER},
+        "acceleration": {"type": "array", "items": _NUMBER},
+        "models": {"type": "array", "items": {"type": "string"}},
+    },
+    "required": ["t", "ids", "x", "y", "speed", "acceleration", "models"], "additionalProperties": False,
+}
+
+
+def to_ns(t: float) -> int:
+    """Simulated time in seconds -> integer nanoseconds."""
+    return int(round(t * 1e9))
+
+
+class LogRecorder:
+    """Write one run's MCAP log; use as a context manager.
+
+    Args:
+        path: the ``.mcap`` file to create.
+        sensor_names: the sensor channels, in order.
+        force: overwrite an existing file (otherwise refuse).
+        chunk_size: bytes per chunk; small chunks lose little when the process is killed.
+    """
+
+    def __init__(self, path: str | Path, sensor_names: Iterable[str], force: bool = False,
+                 chunk_size: int = 256 * 1024) -> None:
+        self.path = Path(path)
+        if self.path.exists() and not force:
+            raise LogError(f"{self.path}: exists; refusing to overwrite a log (use --force)")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self._stream: IO[bytes] = open(self.path, "wb")
+        except OSError as exc:
+            raise LogError(f"{self.path}: cannot create the log ({exc.strerror})") from None
+        self._writer = Writer(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        self._writer.start(profile=PROFILE, library=f"cosim {__version__}")
+        self.sensor_names = list(sensor_names)
+        self._channels: dict[str, int] = {}
+        self._sequence = 0
+        self._closed = False
+        self.final_state: str | None = None
+        for topic, title, schema in (
+            (TOPIC_SENSORS, "cosim.SensorSample", sensors_schema(self.sensor_names)),
+            (TOPIC_VEHICLES, "cosim.VehiclesOnDeck", VEHICLES_SCHEMA),
+            (TOPIC_EVENTS, "cosim.TrafficEvent", EVENTS_SCHEMA),
+            (TOPIC_STATUS, "cosim.RunStatus", STATUS_SCHEMA),
+            (TOPIC_TRAFFIC, "cosim.TrafficFrame", TRAFFIC_SCHEMA),
+        ):
+            sid = self._writer.register_schema(title, "jsonschema", json.dumps(schema).encode())
+            self._channels[topic] = self._writer.register_channel(topic, "json", sid)
+        self._last_t = 0.0
+
+    # --------------------------------------------------------------- content
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        """Store an input file or a derived document (resolved parameters, modes) in the log."""
+        if isinstance(data, str):
+            data = data.encode()
+        self._writer.add_attachment(0, 0, name, media_type, data)
+
+    def metadata(self, name: str, values: dict[str, str]) -> None:
+        self._writer.add_metadata(name, {k: str(v) for k, v in values.items()})
+
+    def write(self, topic: str, t: float, message: dict[str, Any]) -> None:
+        """One JSON message on ``topic`` at simulated time ``t`` (s)."""
+        ns = to_ns(t)
+        self._sequence += 1
+        # orjson: the logging budget is a fraction of a ~20 us solver step per sample.
+        self._writer.add_message(self._channels[topic], ns, orjson.dumps(message), ns, self._sequence)
+        self._last_t = t
+
+    def status(self, t: float, state: str, message: str = "", progress: float | None = None,
+               wall_time: float | None = None) -> None:
+        msg: dict[str, Any] = {"t": t, "state": state}
+        if message:
+            msg["message"] = message
+        if progress is not None:
+            msg["progress"] = progress
+        if wall_time is not None:
+            msg["wall_time"] = wall_time
+        self.write(TOPIC_STATUS, t, msg)
+        if state != "running":
+            self._stream.flush()
+
+    def flush(self) -> None:
+        """Push what the writer has finished to the operating system."""
+        self._stream.flush()
+
+    # ------------------------------------------------------------- lifecycle
+    def close(self, state: str = "finished", message: str = "", wall_time: float | None = None) -> None:
+        """Write the final status and finish the file (summary, index); idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self.final_state = state
+        try:
+            self.status(self._last_t, state, message, wall_time=wall_time)
+        finally:
+            self._writer.finish()
+            self._stream.close()
+
+    def __enter__(self) -> "LogRecorder":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        if exc_type is None:
+            self.close("finished")
+        elif issubclass(exc_type, KeyboardInterrupt):
+            self.close("interrupted", "interrupted by the user (SIGINT)")
+        else:
+            self.close("error", f"{exc_type.__name__}: {exc}")
+
+
+# ------------------------------------------------------------------ reading
+@dataclass
+class LogContents:
+    """What a log holds. ``messages`` maps topic -> list of (log_time ns, decoded JSON)."""
+
+    path: Path
+    profile: str = ""
+    messages: dict[str, list[tuple[int, dict]]] = field(default_factory=dict)
+    attachments: dict[str, bytes] = field(default_factory=dict)
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    truncated: bool = False
+
+    @property
+    def final_status(self) -> dict | None:
+        status = self.messages.get(TOPIC_STATUS, [])
+        return status[-1][1] if status else None
+
+    def topic(self, name: str) -> list[dict]:
+        return [m for _, m in self.messages.get(name, [])]
+
+
+def _decode(path: Path, channel: Channel, data: bytes) -> dict:
+    if channel.message_encoding != "json":
+        raise LogError(f"{path}: channel {channel.topic} is {channel.message_encoding!r}, not a cosim JSON channel")
+    try:
+        return json.loads(data)
+    except (ValueError, UnicodeDecodeError):
+        raise LogError(f"{path}: a message on {channel.topic} is not valid JSON") from None
+
+
+def read_log(path: str | Path, topics: Iterable[str] | None = None) -> LogContents:
+    """Read a cosim log; a log cut short (process killed) is read up to its last complete chunk.
+
+    Raises:
+        LogError: the file is missing, not MCAP, or not a cosim log.
+    """
+    path = Path(path)
+    wanted = set(topics) if topics is not None else None
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise LogError(f"{path}: cannot read ({exc.strerror})") from None
+    if not raw.startswith(b"\x89MCAP0\r\n"):
+        raise LogError(f"{path}: not an MCAP file")
+    out = LogContents(path=path)
+    try:
+        reader = make_reader(io.BytesIO(raw), validate_crcs=True)
+        header = reader.get_header()
+        out.profile = header.profile
+        for _, channel, message in reader.iter_messages(topics=list(wanted) if wanted else None):
+            out.messages.setdefault(channel.topic, []).append((message.log_time, _decode(path, channel, message.data)))
+        for att in reader.iter_attachments():
+            out.attachments[att.name] = att.data
+        for meta in reader.iter_metadata():
+            out.metadata[meta.name] = dict(meta.metadata)
+    except (McapError, EOFError, ValueError, KeyError, OSError):
+        out = _read_stream(path, raw, wanted)
+    if out.profile != PROFILE:
+        raise LogError(f"{path}: an MCAP file, but not a cosim log (profile {out.profile!r})")
+    for msgs in out.messages.values():
+        msgs.sort(key=lambda item: item[0])
+    return out
+
+
+def _read_stream(path: Path, raw: bytes, wanted: set[str] | None) -> LogContents:
+    """Record-by-record read that stops at the first incomplete record (a truncated file)."""
+    out = LogContents(path=path, truncated=True)
+    channels: dict[int, Channel] = {}
+    records: Iterator = StreamReader(io.BytesIO(raw), validate_crcs=True).records
+    complete = False
+    try:
+        for record in records:
+            if isinstance(record, Header):
+                out.profile = record.profile
+            elif isinstance(record, Channel):
+                channels[record.id] = record
+            elif isinstance(record, Message):
+                channel = channels.get(record.channel_id)
+                if channel is not None and (wanted is None or channel.topic in wanted):
+                    out.messages.setdefault(channel.topic, []).append(
+                        (record.log_time, _decode(path, channel, record.data)))
+            elif isinstance(record, Attachment):
+                out.attachments[record.name] = record.data
+            elif isinstance(record, Metadata):
+                out.metadata[record.name] = dict(record.metadata)
+            elif isinstance(record, Footer):
+                complete = True
+    except LogError:
+        raise
+    except Exception:  # noqa: BLE001 - any malformed record ends the readable part of a cut-off file
+        pass
+    if not out.profile:
+        raise LogError(f"{path}: an MCAP file whose header cannot be read")
+    out.truncated = not complete
+    return out
+
+
+def file_is_complete(path: str | Path) -> bool:
+    """True when the log was finished (it ends with the MCAP footer and magic)."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(0, os.SEEK_END)
+            if fh.tell() < 16:
+                return False
+            fh.seek(-8, os.SEEK_END)
+            return fh.read(8) == b"\x89MCAP0\r\n"
+    except OSError:
+        return False
+
+
+class BlockLogger:
+    """Observer of :func:`cosim.simulation.simulate` that streams every block into a :class:`LogRecorder`.
+
+    Sensor samples and vehicles on the deck at the logging rate (the
+    simulation's ``output_every``); traffic events (entered/left the deck,
+    lift-off/touch-down) at every step; a "running" status every
+    ``status_every`` seconds of simulated time. Nothing is accumulated.
+
+    Encoding and writing run in a background thread while the (GIL-free)
+    compiled solver computes the next block, so logging costs little wall
+    time on a machine with a spare core; the queue holds a few blocks at most.
+    Use as a context manager (or call :meth:`close`) so the thread drains.
+    """
+
+    def __init__(self, recorder: LogRecorder, sensor_names: Iterable[str], total_time: float,
+                 status_every: float = 10.0, threaded: bool = True) -> None:
+        self.rec = recorder
+        self.names = list(sensor_names)
+        self.total_time = total_time
+        self.status_every = status_every
+        self._next_status = status_every
+        self._on: dict[str, bool] = {}
+        self._lifted: dict[str, bool] = {}
+        self._model_names: dict[str, str] = {}
+        self._error: BaseException | None = None
+        self._queue: queue.Queue | None = None
+        self._thread: threading.Thread | None = None
+        if threaded:
+            self._queue = queue.Queue(maxsize=4)
+            self._thread = threading.Thread(target=self._drain, name="cosim-log-writer", daemon=True)
+            self._thread.start()
+
+    def on_block(self, times, keep, report) -> None:
+        if self._error is not None:
+            raise LogError(f"{self.rec.path}: writing the log failed: {self._error}")
+        if self._queue is None:
+            self._write_block(times, keep, report)
+        else:
+            self._queue.put((times, keep, report))
+
+    def _drain(self) -> None:
+        assert self._queue is not None
+        while True:
+            item = self._queue.get()
+            if item is None:
+                return
+            if self._error is None:
+                try:
+                    self._write_block(*item)
+                except BaseException as exc:  # noqa: BLE001 - reported to the solver thread
+                    self._error = exc
+
+    def close(self) -> None:
+        """Wait until every queued block is written."""
+        if self._thread is not None and self._queue is not None:
+            self._queue.put(None)
+            self._thread.join()
+            self._thread = None
+        if self._error is not None:
+            raise LogError(f"{self.rec.path}: writing the log failed: {self._error}")
+
+    def __enter__(self) -> "BlockLogger":
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            self.close()
+        except LogError:
+            if exc_type is None:
+                raise
+
+    def _write_block(self, times, keep, report) -> None:
+        rec = self.rec
+        names = self.names
+        sensors = report.sensors
+        for k in np.flatnonzero(keep):
+            t = float(times[k])
+            msg = {"t": t}
+            msg.update(zip(names, sensors[k].tolist()))
+            rec.write(TOPIC_SENSORS, t, msg)
+        if report.ids:
+            self._events(times, report)
+            self._vehicles(times, keep, report)
+        if times[-1] >= self._next_status:
+            rec.status(float(times[-1]), "running", progress=float(times[-1] / self.total_time))
+            rec.flush()
+            self._next_status += self.status_every
+
+    def _events(self, times, report) -> None:
+        """Entered/left the deck and lift-off/touch-down: transitions at any step of the block."""
+        ids = report.ids
+        on = report.on_deck
+        lifted = on & (report.contact_force < 0)
+        prev_on = np.array([self._on.get(v, False) for v in ids])
+        prev_lift = np.array([self._lifted.get(v, False) for v in ids])
+        for state, prev, names in ((on, prev_on, ("left", "entered")), (lifted, prev_lift, ("touchdown", "liftoff"))):
+            changed = np.diff(np.vstack([prev[None, :], state]).astype(np.int8), axis=0) != 0
+            for k, j in zip(*np.nonzero(changed)):
+                t = float(times[k])
+                self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": names[int(state[k, j])],
+                                                 "x": float(report.x[k, j])})
+        for j, vid in enumerate(ids):
+            self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
+
+    def _vehicles(self, times, keep, report) -> None:
+        ids = report.ids
+        for vid, model in zip(ids, report.models):
+            if vid not in self._model_names:
+                self._model_names[vid] = getattr(model, "kind", type(model).__name__)
+        on = report.on_deck
+        for k in np.flatnonzero(keep & on.any(axis=1)):
+            t = float(times[k])
+            cols = np.flatnonzero(on[k])
+            x, v, a = report.x[k, cols].tolist(), report.v[k, cols].tolist(), report.a[k, cols].tolist()
+            y = report.y[cols].tolist()
+            bu, ba, f = (report.body_displacement[k, cols].tolist(), report.body_acceleration[k, cols].tolist(),
+                         report.contact_force[k, cols].tolist())
+            vehicles = [
+                {"id": ids[j], "model": self._model_names[ids[j]], "x": x[i], "y": y[i], "speed": v[i],
+                 "acceleration": a[i], "body_displacement": bu[i], "body_acceleration": ba[i],
+                 "contact_force": f[i]}
+                for i, j in enumerate(cols)
+            ]
+            self.rec.write(TOPIC_VEHICLES, t, {"t": t, "vehicles": vehicles})
