@@ -3,10 +3,12 @@
 Subcommands::
 
     cosim modes SCENARIO [--count N] [--json] [--plot FILE.png]
-    cosim run [SCENARIO] [--out SUMMARY.json]
+    cosim run [SCENARIO] [--out CSV] [--force] [--quiet]
 
 Every :class:`cosim.errors.CosimError` becomes ``cosim: error: <message>`` on
-stderr and exit status 2 (as for usage errors); Ctrl-C exits with 130.
+stderr and exit status 2 (as for usage errors); a :class:`cosim.errors.ModelError`
+during the time integration (the solution diverged) exits with 1; Ctrl-C exits
+with 130.
 """
 from __future__ import annotations
 
@@ -24,16 +26,26 @@ import numpy as np
 
 from . import __version__
 from .bridge import BridgeModel, ModalResult, PointLoad
-from .errors import CosimError
+from .errors import CosimError, ModelError
 from .scenario import Scenario, list_bundled_scenarios, load_scenario
 from .section import SectionProperties
+from .simulation import SimulationResult
 
 DEFAULT_SCENARIO = "paper-double-tee"
 STATIC_LOAD_N = 100e3
-NOT_YET = (
-    "vehicles and time integration are not implemented yet; "
+NO_VEHICLES = (
+    "the scenario has no [[vehicles]]; "
     "this run does the modal analysis and a static load case"
 )
+#: Summary units per sensor quantity: (unit, factor from SI).
+DISPLAY_UNITS: dict[str, tuple[str, float]] = {
+    "displacement": ("mm", 1e3),
+    "velocity": ("mm/s", 1e3),
+    "acceleration": ("m/s^2", 1.0),
+    "bending_moment": ("kN m", 1e-3),
+}
+EXIT_RUN_FAILED = 1
+EXIT_INTERRUPTED = 130
 MAX_PLOTTED_MODES = 6
 NEGLIGIBLE_SHARE = 1e-3  # plotted fields below this share of the largest are drawn as zero
 
@@ -271,13 +283,22 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    if args.out is not None:
-        if Path(args.out).suffix.lower() == ".mcap":
-            raise CosimError(f"{args.out}: MCAP logs are not implemented yet; give a .json path for the summary")
-        _check_output(args.out, "summary")
+    if args.out is not None and Path(args.out).suffix.lower() == ".mcap":
+        raise CosimError(
+            f"{args.out}: MCAP logs are not implemented yet; give a .csv path for the sensor time histories"
+        )
     scenario = load_scenario(args.scenario)
+    if scenario.vehicles:
+        return _run_vehicles(scenario, args)
+    return _run_static(scenario, args)
+
+
+def _run_static(scenario: Scenario, args: argparse.Namespace) -> int:
+    """Without vehicles: the modes and a static load case; ``--out`` writes them as JSON."""
+    if args.out is not None:
+        _check_output(args.out, "summary")
     print(_scenario_line(scenario))
-    print(f"note: {NOT_YET}")
+    print(f"note: {NO_VEHICLES}")
     bridge = scenario.build_bridge()
     modal = bridge.modes(count=10)
     cases = _static_cases(scenario, bridge)
@@ -289,7 +310,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         summary = {
             "scenario": scenario.title,
             "source": scenario.source,
-            "note": NOT_YET,
+            "note": NO_VEHICLES,
             "section": _section_payload(bridge.section),
             "damping": _damping_payload(bridge),
             "modes": _modes_payload(modal),
@@ -301,6 +322,220 @@ def _cmd_run(args: argparse.Namespace) -> int:
         except OSError as exc:
             raise CosimError(f"{args.out}: cannot write the summary ({exc.strerror or exc})") from None
         print(f"\nWrote the summary to {args.out}")
+    return 0
+
+
+class _Progress:
+    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise."""
+
+    def __init__(self, duration: float, show: bool) -> None:
+        self.duration = duration
+        self.fraction = 0.0
+        self._stream = sys.stderr
+        self._bar: Any = None
+        self._tenths: int | None = None  # the light form: tenths printed so far
+        if not show:
+            return
+        if self._stream.isatty():
+            from tqdm import tqdm
+
+            self._bar = tqdm(
+                total=duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
+                bar_format="{desc} {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]",
+            )
+        else:
+            self._tenths = 0
+            print(f"Simulating {duration:g} s:", end="", file=self._stream, flush=True)
+
+    def __call__(self, fraction: float) -> None:
+        self.fraction = fraction
+        if self._bar is not None:
+            self._bar.update(min(fraction * self.duration, self.duration) - self._bar.n)
+        elif self._tenths is not None:
+            reached = int(fraction * 10 + 1e-9)
+            if reached > self._tenths:
+                self._tenths = reached
+                print(f" {10 * reached}%", end="", file=self._stream, flush=True)
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+        elif self._tenths is not None:
+            print(file=self._stream, flush=True)
+            self._tenths = None
+
+
+def _prepare_csv(path: Path, force: bool) -> None:
+    """Fail before the run when the CSV cannot be written; create its folder."""
+    if path.is_dir():
+        raise CosimError(f"{path}: is a directory, expected a file name for the sensor CSV")
+    if path.exists() and not force:
+        raise CosimError(f"{path}: already exists; use --force to overwrite it, or --out to write elsewhere")
+    blocking = next((folder for folder in reversed(path.parents) if folder.exists() and not folder.is_dir()), None)
+    if blocking is not None:
+        raise CosimError(f"{path}: cannot create the folder for the sensor CSV: {str(blocking)!r} is a file")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CosimError(
+            f"{path}: cannot create the folder for the sensor CSV ({exc.strerror or exc})"
+        ) from None
+
+
+def _write_csv(result: SimulationResult, path: Path, force: bool) -> None:
+    """Write through a temporary file, so a failed write leaves no half file behind."""
+    if path.exists() and not force:  # appeared during the run
+        raise CosimError(f"{path}: already exists (created during the run); use --force to overwrite it")
+    partial = path.with_name(path.name + ".part")
+    try:
+        result.write_csv(partial)
+        os.replace(partial, path)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        raise CosimError(f"{path}: cannot write the sensor CSV ({exc.strerror or exc})") from None
+
+
+def _g(value: float, digits: int = 6) -> str:
+    return f"{float(value):.{digits}g}"
+
+
+_PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m"}
+
+
+def _vehicle_lines(scenario: Scenario) -> list[str]:
+    rows = []
+    for v in scenario.vehicles:
+        if v.profile is not None:
+            speed = "profile " + " ".join(f"{_g(t)}s:{_g(vv)}" for t, vv in v.profile)
+        else:
+            speed = _g(v.speed or 0.0)
+        params = ", ".join(f"{k} = {_g(val)} {_PARAMETER_UNITS[k]}" for k, val in v.parameters.items())
+        rows.append((v.id, v.model, f"{v.y:.3f}", v.direction, speed, _g(v.entry_time), params))
+    heads = ("id", "model", "y [m]", "dir", "speed [m/s]", "entry [s]", "parameters")
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(heads[:-1])]
+    fmt = "  " + "  ".join(f"{{:<{w}}}" for w in widths) + "  {}"
+    return [f"Vehicles ({len(rows)})", fmt.format(*heads), *(fmt.format(*r) for r in rows)]
+
+
+def _road_line(scenario: Scenario) -> str:
+    road = scenario.road
+    paths = ", ".join(f"{y:g}" for y in scenario.wheel_paths())
+    if road.random:
+        return (f"Road: ISO 8608 class {road.road_class}, seed {road.seed}, one profile per wheel path "
+                f"(y = {paths} m), x = -10 m to L + 10 m")
+    if road.profile is not None:
+        return f"Road: profile {scenario.road_profile_path} (x, r), on every wheel path"
+    return "Road: smooth"
+
+
+def _solver_line(scenario: Scenario, duration: float) -> str:
+    solver = scenario.solver
+    scheme = solver.scheme if solver.scheme != "hht" else f"hht (alpha = {_g(solver.hht_alpha or 0.0)})"
+    basis = solver.basis
+    if solver.basis == "modal":
+        if solver.modes is not None:
+            basis += f" ({solver.modes} modes)"
+        else:
+            basis += f" (modes below {_g(solver.cutoff_hz or 0.0)} Hz)"
+    if solver.duration is not None:
+        how = "given"
+    else:
+        how = f"last vehicle leaves the deck at {_g(scenario.leave_time or 0.0, 4)} s, + 2 s"
+    steps = int(round(duration / solver.dt))
+    every = f", sampled every {scenario.output.every} steps" if scenario.output.every > 1 else ""
+    return (f"Solver: {scheme}, {basis} basis, dt = {_g(solver.dt)} s, duration {_g(duration, 4)} s ({how}), "
+            f"{steps} steps{every}, g = {_g(solver.gravity)} m/s^2")
+
+
+def _sensor_summary(scenario: Scenario, result: SimulationResult) -> list[str]:
+    if not scenario.sensors:
+        return ["Sensors: none (the scenario has no [[sensors]]; the CSV has only the time column)"]
+    names = [s.name for s in scenario.sensors]
+    width = max(len("name"), *(len(n) for n in names))
+    lines = [
+        "Sensors: peaks over the run",
+        f"  {'name':<{width}}  {'quantity':<14}{'x [m]':>8}{'y [m]':>8}{'min':>12}{'max':>12}  unit",
+    ]
+    for s in scenario.sensors:
+        unit, factor = DISPLAY_UNITS[s.quantity]
+        values = result.sensors[s.name] * factor
+        lo, hi = (float(values.min()), float(values.max())) if len(values) else (0.0, 0.0)
+        lines.append(f"  {s.name:<{width}}  {s.quantity:<14}{s.x:8.3f}{s.y:8.3f}{lo:12.4g}{hi:12.4g}  {unit}")
+    return lines
+
+
+def _vehicle_summary(scenario: Scenario, result: SimulationResult) -> list[str]:
+    ids = [v.id for v in scenario.vehicles]
+    width = max(len("id"), *(len(i) for i in ids))
+    sampled = " (sampled)" if scenario.output.every > 1 else ""
+    lines = [
+        f"Vehicles: contact force, compression positive{sampled}",
+        f"  {'id':<{width}}  {'on the deck [s]':<18}{'min [kN]':>10}{'max [kN]':>10}  lifted off",
+    ]
+    for vid in ids:
+        if vid not in result.vehicle_ids:
+            lines.append(f"  {vid:<{width}}  not on the deck during the run")
+            continue
+        data = result.vehicle(vid)
+        force = data["contact_force"] / 1e3
+        t = data["t"]
+        on_deck = f"{t.min():.3f} - {t.max():.3f}"
+        lifted = "yes" if force.min() < 0 else "no"
+        lines.append(f"  {vid:<{width}}  {on_deck:<18}{force.min():10.3f}{force.max():10.3f}  {lifted}")
+    return lines
+
+
+def _run_lines(result: SimulationResult, duration: float) -> list[str]:
+    events, steps = result.liftoff_events, result.liftoff_steps
+    lines = [f"Lift-off events: {events} ({steps} vehicle-steps with a negative contact force)"]
+    if events:
+        lines.append("  the contact is kept (bilateral) through a lift-off, as in the paper: "
+                     "results after it assume the wheel stays on the deck")
+    wall = result.wall_time
+    factor = f"{duration / wall:.3g}" if wall > 0 else "inf"
+    lines.append(f"Time stepping: {result.steps} steps in {wall:.2f} s wall time; "
+                 f"real-time factor {factor} (simulated time / wall time)")
+    basis = result.info.get("basis", "?")
+    lines.append(f"Effective-matrix factorisations: {result.factorizations} "
+                 f"({basis} basis, {result.info.get('n_reduced', '?')} unknowns)")
+    return lines
+
+
+def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
+    """With [[vehicles]]: the time simulation, the sensor CSV and a summary."""
+    csv_path = Path(args.out) if args.out is not None else scenario.csv_path
+    _prepare_csv(csv_path, args.force)
+    duration = scenario.duration
+    print(_scenario_line(scenario))
+    bridge = scenario.build_bridge()
+    spans = " + ".join(f"{span:g}" for span in bridge.spans)
+    print(f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements")
+    _print(_damping_lines(bridge))
+    _print(_vehicle_lines(scenario))
+    print(_road_line(scenario))
+    print(_solver_line(scenario, duration))
+    sys.stdout.flush()
+    progress = _Progress(duration, show=not args.quiet)
+    try:
+        result = scenario.simulate(progress, bridge=bridge)
+    except ModelError as exc:
+        progress.close()
+        _report(f"{exc} (the run failed; {csv_path} was not written)")
+        return EXIT_RUN_FAILED
+    except KeyboardInterrupt:
+        progress.close()
+        print(f"cosim: interrupted at about t = {progress.fraction * duration:.3g} s of {duration:g} s; "
+              f"{csv_path} was not written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    progress.close()
+    _write_csv(result, csv_path, args.force)
+    print()
+    _print(_sensor_summary(scenario, result))
+    _print(_vehicle_summary(scenario, result))
+    _print(_run_lines(result, duration))
+    columns = ",".join(["t", *result.sensors])
+    print(f"Wrote {len(result.t)} rows to {csv_path} (columns {columns}; SI units: m, m/s, m/s^2, N m)")
     return 0
 
 
@@ -387,22 +622,32 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser(
         "run",
-        help="run a scenario (for now: modes and a static load case)",
+        help="run a scenario: the time simulation of its vehicles (or, without any, modes and a static case)",
         description=textwrap.dedent(
             f"""\
-            Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}'.
+            Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}' (the paper's
+            two quarter-cars crossing its 40 m double-tee bridge).
 
-            For now vehicles and time integration are not implemented: the run does
-            the modal analysis (the first 10 modes) and a static load case, a
-            {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once on
-            the bridge axis (y = 0) and once at the left deck edge (largest y), and
-            prints each sensor's deck displacement for both."""
+            With [[vehicles]]: integrate the coupled vehicle-bridge equations in time,
+            write every sensor's time history to a CSV file (columns t,<sensor names>,
+            SI units) and print a summary: sensor peaks, each vehicle's contact
+            force and whether it lifted off, steps, wall time, real-time factor and
+            factorisation count. A progress display goes to stderr.
+
+            Without [[vehicles]]: the modal analysis (first 10 modes) and a static load
+            case, a {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once
+            on the bridge axis (y = 0) and once at the left deck edge (largest y),
+            with each sensor's deck displacement for both.
+
+            Exit status: 0 done, 1 the solution diverged, 2 bad input, 130 interrupted
+            (Ctrl-C; no CSV is written then)."""
         ),
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run
-              cosim run my-bridge.toml --out summary.json
+              cosim run                              # the paper's case -> runs/{DEFAULT_SCENARIO}.csv
+              cosim run my-bridge.toml --out results/run1.csv --force
+              cosim run my-bridge-no-vehicles.toml --out summary.json
             """
         )
         + "\n"
@@ -412,8 +657,13 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", metavar="SCENARIO", nargs="?", default=DEFAULT_SCENARIO,
                      help=f"scenario file (.toml) or bundled scenario name (default: {DEFAULT_SCENARIO})")
     run.add_argument("--out", metavar="PATH",
-                     help="write the summary (modes, static displacements) as JSON to PATH "
-                          "(MCAP logs come with the co-simulation)")
+                     help="with vehicles: the sensor CSV (default: [output].csv, else runs/<scenario name>.csv; "
+                          "its folder is created); without vehicles: write the modes and static "
+                          "displacements as JSON to PATH")
+    run.add_argument("--force", "-f", action="store_true",
+                     help="overwrite the sensor CSV if it exists (default: refuse)")
+    run.add_argument("--quiet", "-q", action="store_true",
+                     help="no progress display on stderr")
     run.set_defaults(func=_cmd_run)
     return parser
 

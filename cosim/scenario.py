@@ -1,8 +1,9 @@
 """Scenario files: TOML in, frozen and validated configuration objects out.
 
 A scenario describes one bridge (spans, material, cross-section, supports,
-damping), its sensors and the solver settings; ``docs/scenario.md`` documents
-every key with its unit, default and constraints.
+damping), its sensors, scripted vehicles, the road surface, the solver
+settings and where results go; ``docs/scenario.md`` documents every key with
+its unit, default and constraints.
 
 Typical use::
 
@@ -10,6 +11,12 @@ Typical use::
 
     scenario = load_scenario("paper-double-tee")      # a bundled scenario, or a path
     bridge = scenario.build_bridge()                  # cosim.bridge.BridgeModel
+    result = scenario.simulate()                      # cosim.simulation.SimulationResult
+
+The pieces :meth:`Scenario.simulate` wires together are available one by one:
+:meth:`Scenario.build_vehicles` (a :class:`cosim.traffic.ScriptedTraffic`),
+:meth:`Scenario.build_road` (a :class:`cosim.roughness.RoadProfile`),
+:meth:`Scenario.solver_settings` and :meth:`Scenario.sensors_core`.
 
 Every problem with a scenario (missing file, TOML syntax, unknown or missing
 key, wrong type, non-physical value) raises :class:`cosim.errors.ConfigError`
@@ -34,8 +41,9 @@ import sys
 import types
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Iterator, Union, get_args, get_origin
+from typing import Annotated, Any, Callable, Iterator, Union, get_args, get_origin
 
+import numpy as np
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -44,6 +52,7 @@ from pydantic import (
     PrivateAttr,
     Strict,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -51,7 +60,11 @@ from pydantic import (
 from .bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, ExplicitDamping, RayleighDamping, build_bridge
 from .bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
 from .errors import ConfigError, ModelError
+from .roughness import ISO_CLASSES, RoadProfile, iso8608_profile, profile_from_csv, smooth_road
 from .section import Material, Plate, SectionProperties, section_from_constants, section_from_plates
+from .simulation import Sensor, SimulationResult, SolverSettings, simulate
+from .traffic import ScriptedTraffic, ScriptedVehicle
+from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -65,13 +78,18 @@ __all__ = [
     "DOF_NAMES",
     "MODE_KINDS",
     "MaterialConfig",
+    "OutputConfig",
     "PlateConfig",
     "QUANTITIES",
+    "ROAD_CLASSES",
+    "RoadConfig",
     "SUPPORT_PRESETS",
     "Scenario",
     "SectionConfig",
     "SensorConfig",
     "SolverConfig",
+    "VEHICLE_MODELS",
+    "VehicleConfig",
     "list_bundled_scenarios",
     "load_scenario",
     "parse_scenario",
@@ -85,22 +103,37 @@ MODE_KINDS: tuple[str, ...] = tuple(_BRIDGE_MODE_KINDS)
 #: Sensor quantities.
 QUANTITIES: tuple[str, ...] = ("displacement", "velocity", "acceleration", "bending_moment")
 
-SCHEMES: tuple[str, ...] = ("newmark", "hht", "generalized-alpha")
+SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
+
+#: Vehicle models of ``[[vehicles]]`` and their parameters: name -> (required, optional with default).
+VEHICLE_MODELS: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
+    "moving-force": (("mass",), {}),
+    "quarter-car": (("m_v", "m_w", "k_v", "c_v"), {}),
+    "tyre-quarter-car": (("m_v", "m_w", "k_v", "c_v", "k_t"), {"c_t": 0.0}),
+    "golden-car": (("m_v",), {}),
+}
+VEHICLE_PARAMETERS: tuple[str, ...] = ("mass", "m_v", "m_w", "k_v", "c_v", "k_t", "c_t")
+DIRECTIONS: dict[str, int] = {"+x": 1, "-x": -1}
+
+#: ``[road].class``: an ISO 8608 class, or a smooth road.
+ROAD_CLASSES: tuple[str, ...] = (*ISO_CLASSES, "smooth")
+#: Random road profiles cover the deck plus this margin at both ends, m.
+ROAD_MARGIN = 10.0
 
 #: Top-level sections that later versions add; rejected for now with a clear note.
 FUTURE_SECTIONS: dict[str, str] = {
-    "traffic": "SUMO traffic",
-    "vehicles": "scripted vehicles",
-    "road": "road roughness",
-    "output": "MCAP output",
+    "traffic": "SUMO traffic; use [[vehicles]] for scripted vehicles",
 }
 
 _MODE_REF = re.compile(r"(?P<kind>[a-z]+)-(?P<n>[0-9]+)")
+_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
 
 DEFAULT_HHT_ALPHA = -0.05
-DEFAULT_RHO_INF = 0.8
 DEFAULT_MODAL_MODES = 30
+#: Without ``solver.duration``, the run lasts until the last vehicle leaves the deck plus this, s.
+RING_DOWN = 2.0
+DEFAULT_OUTPUT_DIR = "runs"
 
 
 # --------------------------------------------------------------------------- errors
@@ -183,6 +216,18 @@ def _unwrap(annotation: Any) -> Any:
             return annotation
 
 
+def _keys(model: type[BaseModel]) -> list[str]:
+    """The TOML keys of a table: field aliases where given (``class``), else field names."""
+    return [field.alias or name for name, field in model.model_fields.items()]
+
+
+def _field(model: type[BaseModel], key: str) -> Any:
+    for name, field in model.model_fields.items():
+        if key in (name, field.alias):
+            return field
+    return None
+
+
 def _model_at(root: type[BaseModel], loc: tuple[str | int, ...]) -> type[BaseModel] | None:
     """The model class that validates the table at ``loc`` (None if not a table)."""
     annotation: Any = root
@@ -195,7 +240,7 @@ def _model_at(root: type[BaseModel], loc: tuple[str | int, ...]) -> type[BaseMod
             continue
         if not (isinstance(annotation, type) and issubclass(annotation, BaseModel)):
             return None
-        field = annotation.model_fields.get(part)
+        field = _field(annotation, part)
         if field is None:
             return None
         annotation = field.annotation
@@ -260,7 +305,7 @@ def _format_one(root: type[BaseModel], error: dict[str, Any]) -> list[tuple[str,
         return [(_path(loc), message)]
     if kind == "extra_forbidden":
         parent = _model_at(root, loc[:-1])
-        allowed = list(parent.model_fields) if parent is not None else []
+        allowed = _keys(parent) if parent is not None else []
         key = str(loc[-1])
         listed = f"expected one of: {', '.join(allowed)}" if allowed else "no keys expected here"
         if len(loc) == 1 and key in FUTURE_SECTIONS:
@@ -302,7 +347,7 @@ def _config_error(source: str, root: type[BaseModel], exc: ValidationError) -> C
         if error["type"] == "extra_forbidden":
             loc = tuple(error["loc"])
             parent = _model_at(root, loc[:-1])
-            hint = _suggest(str(loc[-1]), list(parent.model_fields)) if parent is not None else None
+            hint = _suggest(str(loc[-1]), _keys(parent)) if parent is not None else None
             if hint is not None:
                 suggested.add(loc[:-1] + (hint,))
     lines: list[str] = []
@@ -688,13 +733,174 @@ class SensorConfig(_Model):
     quantity: Annotated[str, _choice(QUANTITIES, "quantity")] = "displacement"
 
 
+def _number_problem(item: Any) -> str | None:
+    if isinstance(item, bool) or not isinstance(item, (int, float)):
+        return f"expected a number, got {_describe(item)}"
+    if not math.isfinite(item):
+        return f"must be a finite number (got {_show(item)})"
+    return None
+
+
+def _speed_profile(value: Any) -> tuple[tuple[float, float], ...]:
+    """``profile = [[t, v], ...]``: t from entry (s), starting at 0 and increasing; v >= 0 (m/s)."""
+    if not isinstance(value, (list, tuple)) or not value:
+        raise _fail(f"expected a non-empty array of [t, v] pairs (s, m/s), got {_describe(value)}")
+    problems: list[tuple[tuple[int, ...], str]] = []
+    points: list[tuple[float, float]] = []
+    for i, item in enumerate(value):
+        if not isinstance(item, (list, tuple)) or len(item) != 2:
+            problems.append(((i,), f"expected a pair [t, v] (s, m/s), got {_describe(item)}"))
+            continue
+        bad = [((i, j), msg) for j, v in enumerate(item) if (msg := _number_problem(v))]
+        if bad:
+            problems.extend(bad)
+            continue
+        t, v = float(item[0]), float(item[1])
+        if i == 0 and t != 0.0:
+            problems.append(((0, 0), f"the first time must be 0 (time from the vehicle's entry; got {_show(item[0])})"))
+        elif points and t <= points[-1][0]:
+            problems.append(
+                ((i, 0), f"times must increase (got {_show(item[0])} after {_show(points[-1][0])})")
+            )
+        if v < 0:
+            problems.append(((i, 1), f"speed must be >= 0 m/s (got {_show(item[1])})"))
+        points.append((t, v))
+    if problems:
+        raise _Problems(problems)
+    return tuple(points)
+
+
+SpeedProfile = Annotated[tuple[tuple[float, float], ...], PlainValidator(_speed_profile)]
+
+_CORE_KEY = re.compile(r"`(?P<key>\w+)`\s*(?P<rest>.*)", re.S)
+
+
+def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> _Problems:
+    """A core-class message ("quarter-car: `m_v` must be ...") as a problem at that key."""
+    match = _CORE_KEY.search(str(exc))
+    if match and match["key"] in keys:
+        return _fail(match["rest"].strip(), match["key"])
+    return _fail(str(exc))
+
+
+class VehicleConfig(_Model):
+    """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
+
+    id: Annotated[str, Strict(), Field(pattern=_NAME_PATTERN)]
+    model: Annotated[str, _choice(tuple(VEHICLE_MODELS), "vehicle model")]
+    mass: Number | None = None
+    m_v: Number | None = None
+    m_w: Number | None = None
+    k_v: Number | None = None
+    c_v: Number | None = None
+    k_t: Number | None = None
+    c_t: Number | None = None
+    y: Number
+    speed: Positive | None = None
+    entry_time: NonNegative = 0.0
+    direction: Annotated[str, _choice(tuple(DIRECTIONS), "direction")] = "+x"
+    profile: SpeedProfile | None = None
+
+    @model_validator(mode="after")
+    def _parameters(self) -> VehicleConfig:
+        required, optional = VEHICLE_MODELS[self.model]
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        listed = ", ".join((*required, *optional))
+        for key in VEHICLE_PARAMETERS:
+            if getattr(self, key) is not None and key not in required and key not in optional:
+                problems.append(((key,), f"not a parameter of model {_show(self.model)} (its parameters: {listed})"))
+        for key in required:
+            if getattr(self, key) is None:
+                problems.append(((key,), f"required key is missing (model {_show(self.model)} needs {listed})"))
+        if self.speed is not None and self.profile is not None:
+            problems.append((("speed",), "give either speed or profile, not both"))
+        if self.speed is None and self.profile is None:
+            problems.append((("speed",), "required key is missing (give speed, m/s, or a speed profile)"))
+        if problems:
+            raise _Problems(problems)
+        try:
+            self.to_model()
+        except ConfigError as exc:
+            raise _rekeyed(exc, VEHICLE_PARAMETERS) from None
+        return self
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The model's parameters, defaults filled in (SI units)."""
+        required, optional = VEHICLE_MODELS[self.model]
+        values = {key: getattr(self, key) for key in required}
+        values.update({key: getattr(self, key) if getattr(self, key) is not None else default
+                       for key, default in optional.items()})
+        return values
+
+    def to_model(self) -> VehicleModel:
+        """The :mod:`cosim.vehicles` model this table describes.
+
+        Raises:
+            ConfigError: a non-physical parameter (the vehicle classes check them).
+        """
+        p = self.parameters
+        if self.model == "moving-force":
+            return MovingForce(mass=p["mass"])
+        if self.model == "quarter-car":
+            return QuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"])
+        if self.model == "tyre-quarter-car":
+            return TyreQuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"], k_t=p["k_t"], c_t=p["c_t"])
+        return TyreQuarterCar.golden_car(p["m_v"])
+
+    def to_scripted(self) -> ScriptedVehicle:
+        """The :class:`cosim.traffic.ScriptedVehicle` this table describes."""
+        return ScriptedVehicle(
+            id=self.id,
+            model=self.to_model(),
+            y=self.y,
+            speed=self.speed if self.speed is not None else 0.0,
+            entry_time=self.entry_time,
+            direction=DIRECTIONS[self.direction],
+            profile=self.profile or (),
+        )
+
+
+class RoadConfig(_Model):
+    """``[road]``: an ISO 8608 class with a seed, a profile file, or a smooth road."""
+
+    road_class: Annotated[str, _choice(ROAD_CLASSES, "road class")] | None = Field(default=None, alias="class")
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
+    profile: Annotated[str, Strict(), Field(min_length=1)] | None = None
+
+    @model_validator(mode="after")
+    def _one_form(self) -> RoadConfig:
+        if self.road_class is not None and self.profile is not None:
+            raise _fail(f"give either class or profile, not both (got class = {_show(self.road_class)} "
+                        f"and profile = {_show(self.profile)})")
+        if self.random and self.seed is None:
+            raise _fail(
+                f"required key is missing: a random road (class = {_show(self.road_class)}) needs a seed "
+                "(an integer >= 0) so that it can be reproduced, e.g. seed = 1", "seed"
+            )
+        if self.seed is not None and not self.random:
+            where = f"profile = {_show(self.profile)}" if self.profile is not None else (
+                f"class = {_show(self.road_class)}" if self.road_class is not None else "no class")
+            raise _fail(f'only used with a random road, class = "A" ... "H" (got {where})', "seed")
+        return self
+
+    @property
+    def random(self) -> bool:
+        """True for an ISO 8608 class (A-H)."""
+        return self.road_class is not None and self.road_class in ISO_CLASSES
+
+    @property
+    def smooth(self) -> bool:
+        """True for a smooth road (``class = "smooth"`` or nothing given)."""
+        return not self.random and self.profile is None
+
+
 class SolverConfig(_Model):
     """``[solver]``: time integration settings."""
 
     dt: Positive = 0.005
     scheme: Annotated[str, _choice(SCHEMES, "scheme")] = "newmark"
     hht_alpha: Annotated[float, Strict(), Field(ge=-1.0 / 3.0, le=0.0)] | None = None
-    rho_inf: Annotated[float, Strict(), Field(ge=0.0, le=1.0)] | None = None
     basis: Annotated[str, _choice(BASES, "basis")] = "direct"
     modes: PositiveInt | None = None
     cutoff_hz: Positive | None = None
@@ -708,8 +914,6 @@ class SolverConfig(_Model):
             data = dict(data)
             if data.get("scheme") == "hht":
                 data.setdefault("hht_alpha", DEFAULT_HHT_ALPHA)
-            if data.get("scheme") == "generalized-alpha":
-                data.setdefault("rho_inf", DEFAULT_RHO_INF)
             if data.get("basis") == "modal" and "cutoff_hz" not in data:
                 data.setdefault("modes", DEFAULT_MODAL_MODES)
         return data
@@ -719,22 +923,65 @@ class SolverConfig(_Model):
         problems = []
         if self.hht_alpha is not None and self.scheme != "hht":
             problems.append((("hht_alpha",), f'only used with scheme = "hht" (got scheme = "{self.scheme}")'))
-        if self.rho_inf is not None and self.scheme != "generalized-alpha":
-            problems.append(
-                (("rho_inf",), f'only used with scheme = "generalized-alpha" (got scheme = "{self.scheme}")')
-            )
         for key in ("modes", "cutoff_hz"):
             if getattr(self, key) is not None and self.basis != "modal":
                 problems.append(((key,), f'only used with basis = "modal" (got basis = "{self.basis}")'))
         if self.basis == "modal" and self.modes is not None and self.cutoff_hz is not None:
             problems.append((("cutoff_hz",), "give either modes or cutoff_hz for the modal basis, not both"))
+        if self.duration is not None and self.duration < self.dt:
+            problems.append((("duration",), f"must be >= dt = {_show(self.dt)} s (got {_show(self.duration)})"))
         if problems:
             raise _Problems(problems)
         return self
 
+    def to_settings(self) -> SolverSettings:
+        """The :class:`cosim.simulation.SolverSettings` this table describes."""
+        return SolverSettings(
+            dt=self.dt,
+            scheme=self.scheme,
+            hht_alpha=self.hht_alpha if self.hht_alpha is not None else DEFAULT_HHT_ALPHA,
+            basis=self.basis,
+            modes=self.modes,
+            cutoff_hz=self.cutoff_hz,
+            gravity=self.gravity,
+        )
+
+
+class OutputConfig(_Model):
+    """``[output]``: where the sensor time histories go and how often they are sampled."""
+
+    csv: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    every: PositiveInt = 1
+
+
+def _leave_time(vehicle: ScriptedVehicle, length: float) -> float:
+    """When ``vehicle`` leaves a deck of ``length`` m, s from the start (inf if it stops on the deck)."""
+    end = ScriptedTraffic((vehicle,), length).end_time()
+    if math.isfinite(end) or not vehicle.profile:
+        return end
+    # The profile ends at 0 m/s: the vehicle stops; on the deck, or after leaving it?
+    t_last = vehicle.profile[-1][0]
+    if float(vehicle.distance(t_last)[0]) <= length:
+        return math.inf
+    lo, hi = 0.0, t_last  # distance is non-decreasing (speeds >= 0): bisect for distance = length
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if float(vehicle.distance(mid)[0]) > length:
+            hi = mid
+        else:
+            lo = mid
+        if hi - lo <= 1e-9 * max(t_last, 1.0):
+            break
+    return vehicle.entry_time + hi
+
+
+def _file_name(text: str) -> str:
+    """``text`` with anything but letters, digits, '_', '.' and '-' replaced by '_'."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", text) or "scenario"
+
 
 class Scenario(_Model):
-    """A validated scenario: the bridge, its sensors and the solver settings.
+    """A validated scenario: the bridge, its sensors, scripted vehicles, road, solver and output settings.
 
     Build one with :func:`load_scenario` (file or bundled name) or
     :func:`parse_scenario` (TOML text). ``source`` is where it came from and
@@ -745,15 +992,32 @@ class Scenario(_Model):
     description: Text = ""
     bridge: BridgeConfig
     sensors: tuple[SensorConfig, ...] = ()
+    vehicles: tuple[VehicleConfig, ...] = ()
+    road: RoadConfig = RoadConfig()
     solver: SolverConfig = SolverConfig()
+    output: OutputConfig = OutputConfig()
 
     _source: str = PrivateAttr(default="<scenario>")
     _text: str = PrivateAttr(default="")
+    _base_dir: str = PrivateAttr(default=".")
 
     def model_post_init(self, context: Any) -> None:  # noqa: D102
         if isinstance(context, dict):
             self._source = str(context.get("source", self._source))
             self._text = str(context.get("text", self._text))
+            self._base_dir = str(context.get("base_dir", self._base_dir))
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_vehicle_ids(cls, data: Any) -> Any:
+        """Vehicles without an ``id`` are "V1", "V2", ... by their position."""
+        if isinstance(data, dict) and isinstance(data.get("vehicles"), list):
+            data = dict(data)
+            data["vehicles"] = [
+                {"id": f"V{i + 1}", **item} if isinstance(item, dict) and "id" not in item else item
+                for i, item in enumerate(data["vehicles"])
+            ]
+        return data
 
     @model_validator(mode="after")
     def _sensors_on_deck(self) -> Scenario:
@@ -781,6 +1045,68 @@ class Scenario(_Model):
                 )
         if problems:
             raise _Problems(problems)
+        return self
+
+    @model_validator(mode="after")
+    def _vehicles_fit(self) -> Scenario:
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        y_min, y_max = self.bridge.section.deck_y
+        tol_y = 1e-9 * max(y_max - y_min, 1.0)
+        seen: dict[str, int] = {}
+        for i, vehicle in enumerate(self.vehicles):
+            if vehicle.id in seen:
+                problems.append(
+                    (("vehicles", i, "id"),
+                     f"duplicate vehicle id {_show(vehicle.id)} (also vehicles[{seen[vehicle.id]}]; "
+                     "vehicles without an id are named V1, V2, ... by position)")
+                )
+            seen.setdefault(vehicle.id, i)
+            if not y_min - tol_y <= vehicle.y <= y_max + tol_y:
+                problems.append(
+                    (("vehicles", i, "y"),
+                     f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {_show(vehicle.y)})")
+                )
+        if self.vehicles and self.solver.duration is None and not problems:
+            length = self.bridge.length
+            for i, vehicle in enumerate(self.vehicles):
+                scripted = vehicle.to_scripted()
+                if math.isinf(_leave_time(scripted, length)):
+                    s_stop = float(scripted.distance(scripted.profile[-1][0])[0])
+                    x_stop = s_stop if scripted.direction > 0 else length - s_stop
+                    problems.append(
+                        (("solver", "duration"),
+                         f"required key is missing: vehicles[{i}] ({vehicle.id}) stops on the deck at "
+                         f"x = {x_stop:g} m (its speed profile ends at 0 m/s), so the run has no natural end; "
+                         "give the simulated time in s")
+                    )
+                    break
+        if problems:
+            raise _Problems(problems)
+        return self
+
+    @model_validator(mode="after")
+    def _road_file(self, info: ValidationInfo) -> Scenario:
+        if self.road.profile is None:
+            return self
+        base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
+        path = Path(base) / self.road.profile
+        if not path.is_file():
+            raise _fail(
+                f"file not found: {path} (a relative path is relative to the scenario file's folder)",
+                "road", "profile",
+            )
+        try:
+            road = profile_from_csv(path)
+        except ConfigError as exc:
+            raise _fail(str(exc), "road", "profile") from None
+        x_end = road.x0 + road.dx * (road.r.shape[1] - 1)
+        length = self.bridge.length
+        tol = 1e-6 * max(length, 1.0)
+        if road.x0 > tol or x_end < length - tol:
+            raise _fail(
+                f"{path}: the profile covers {road.x0:g} <= x <= {x_end:g} m; it must cover the deck, "
+                f"0 <= x <= {length:g} m", "road", "profile",
+            )
         return self
 
     @property
@@ -834,6 +1160,123 @@ class Scenario(_Model):
                 damping=bridge.damping.to_damping() if bridge.damping is not None else None,
             )
 
+    @property
+    def road_profile_path(self) -> Path | None:
+        """The road profile file (``road.profile`` resolved against the scenario's folder), or None."""
+        if self.road.profile is None:
+            return None
+        return Path(self._base_dir) / self.road.profile
+
+    @property
+    def csv_path(self) -> Path:
+        """Where the sensor CSV goes: ``output.csv``, default ``runs/<title>.csv`` (relative to the current folder)."""
+        if self.output.csv is not None:
+            return Path(self.output.csv)
+        return Path(DEFAULT_OUTPUT_DIR) / f"{_file_name(self.title)}.csv"
+
+    @property
+    def leave_time(self) -> float | None:
+        """When the last scripted vehicle leaves the deck, s (inf if one stops on it; None without vehicles)."""
+        if not self.vehicles:
+            return None
+        length = self.bridge.length
+        return max(_leave_time(v.to_scripted(), length) for v in self.vehicles)
+
+    @property
+    def duration(self) -> float:
+        """Simulated time, s: ``solver.duration``, default :attr:`leave_time` + 2 s.
+
+        Raises:
+            ConfigError: no ``solver.duration`` and no vehicles to take it from.
+        """
+        if self.solver.duration is not None:
+            return self.solver.duration
+        leave = self.leave_time
+        if leave is None:
+            raise ConfigError(
+                f"{self._source}: solver.duration: required key is missing "
+                "(without [[vehicles]] there is no default simulated time)"
+            )
+        return leave + RING_DOWN
+
+    def build_vehicles(self) -> ScriptedTraffic:
+        """The scripted vehicles as a :class:`cosim.traffic.ScriptedTraffic` on this bridge's length."""
+        with self._named("vehicles"):
+            return ScriptedTraffic(tuple(v.to_scripted() for v in self.vehicles), self.bridge.length)
+
+    def wheel_paths(self) -> tuple[float, ...]:
+        """The distinct lateral offsets of the vehicles, sorted, m (``(0.0,)`` without vehicles)."""
+        return tuple(sorted({v.y for v in self.vehicles})) or (0.0,)
+
+    def build_road(self) -> RoadProfile:
+        """The road profile, one wheel path per distinct vehicle offset (:meth:`wheel_paths`).
+
+        A random class covers -10 m <= x <= L + 10 m (L the bridge length) with
+        independent profiles per path, all drawn from ``road.seed``; a profile
+        file is used on every path; no ``[road]`` or ``class = "smooth"`` is a
+        smooth road.
+        """
+        road = self.road
+        paths = self.wheel_paths()
+        with self._named("road"):
+            if road.random:
+                assert road.road_class is not None and road.seed is not None
+                return iso8608_profile(
+                    road.road_class, road.seed, -ROAD_MARGIN, self.bridge.length + ROAD_MARGIN, path_y=paths
+                )
+            path = self.road_profile_path
+            if path is None:
+                return smooth_road()
+            one = profile_from_csv(path)
+            n = len(paths)
+            return RoadProfile(
+                path_y=paths, x0=one.x0, dx=one.dx,
+                r=np.repeat(one.r, n, axis=0), r_x=np.repeat(one.r_x, n, axis=0),
+                description=f"{one.description} on {n} path(s)",
+            )
+
+    def solver_settings(self) -> SolverSettings:
+        """The :class:`cosim.simulation.SolverSettings` of ``[solver]``."""
+        return self.solver.to_settings()
+
+    def sensors_core(self) -> list[Sensor]:
+        """The ``[[sensors]]`` as :class:`cosim.simulation.Sensor` objects."""
+        return [Sensor(name=s.name, x=s.x, y=s.y, quantity=s.quantity) for s in self.sensors]
+
+    def simulate(
+        self,
+        progress: Callable[[float], None] | None = None,
+        *,
+        bridge: BridgeModel | None = None,
+    ) -> SimulationResult:
+        """Run the scenario: bridge, scripted vehicles, road, solver and sensors into :func:`cosim.simulation.simulate`.
+
+        Args:
+            progress: called with the fraction done from time to time.
+            bridge: the model from :meth:`build_bridge`, if already built.
+
+        Returns:
+            The sensor and vehicle time histories, sampled every ``output.every`` steps.
+
+        Raises:
+            ConfigError: the scenario cannot be run as given (e.g. no duration).
+            ModelError: the model cannot be built, or the solution diverges.
+        """
+        if bridge is None:
+            bridge = self.build_bridge()
+        traffic = self.build_vehicles()
+        road = self.build_road()
+        duration = self.duration
+        solver = self.solver_settings()
+        sensors = self.sensors_core()
+        try:
+            return simulate(
+                bridge, traffic, duration, solver=solver, sensors=sensors, road=road,
+                output_every=self.output.every, progress=progress,
+            )
+        except (ConfigError, ModelError) as exc:
+            raise type(exc)(f"{self._source}: {exc}") from exc
+
     @contextlib.contextmanager
     def _named(self, key: str) -> Iterator[None]:
         """Prefix errors of the numerical core with this scenario's source and ``key``."""
@@ -857,12 +1300,16 @@ def list_bundled_scenarios() -> list[str]:
     return sorted(item.name[: -len(".toml")] for item in folder.iterdir() if item.name.endswith(".toml"))
 
 
-def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
+def parse_scenario(
+    text: str, source: str = "<scenario>", base_dir: str | os.PathLike[str] = "."
+) -> Scenario:
     """Validate scenario TOML text.
 
     Args:
         text: the TOML document.
         source: how to name it in error messages (usually the file path).
+        base_dir: the folder relative paths in the scenario (``road.profile``)
+            are resolved against: the scenario file's folder.
 
     Raises:
         ConfigError: syntax error, unknown/missing key, wrong type or non-physical value.
@@ -872,7 +1319,8 @@ def parse_scenario(text: str, source: str = "<scenario>") -> Scenario:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
     try:
-        return Scenario.model_validate(data, context={"source": source, "text": text})
+        context = {"source": source, "text": text, "base_dir": os.fspath(base_dir)}
+        return Scenario.model_validate(data, context=context)
     except ValidationError as exc:
         raise _config_error(source, Scenario, exc) from None
 
@@ -897,11 +1345,12 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
             text = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise ConfigError(f"{source}: cannot read scenario file ({exc})") from None
-        return parse_scenario(text, source)
+        return parse_scenario(text, source, base_dir=path.parent)
     bundled = list_bundled_scenarios()
     if source in bundled:
-        resource = resources.files(_BUNDLED_PACKAGE).joinpath(_BUNDLED_DIR, f"{source}.toml")
-        return parse_scenario(resource.read_text(encoding="utf-8"), source)
+        folder = resources.files(_BUNDLED_PACKAGE).joinpath(_BUNDLED_DIR)
+        resource = folder.joinpath(f"{source}.toml")
+        return parse_scenario(resource.read_text(encoding="utf-8"), source, base_dir=str(folder))
     if path.is_dir():
         raise ConfigError(f"{source}: is a directory, expected a scenario .toml file")
     listed = ", ".join(bundled) or "none"

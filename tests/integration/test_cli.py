@@ -16,6 +16,16 @@ REPO = Path(cosim.__file__).resolve().parents[1]
 PAPER_TEXT = (REPO / "cosim" / "scenarios" / "paper-double-tee.toml").read_text(encoding="utf-8")
 
 
+def _without_vehicles(text: str) -> str:
+    """The paper's bridge and sensors, without its [[vehicles]] and [road]."""
+    start = text.index("[[vehicles]]")
+    start = text.rindex("\n\n", 0, start) + 1  # with the comment above the first vehicle
+    return text[:start] + text[text.index("[solver]"):]
+
+
+PAPER_STATIC_TEXT = _without_vehicles(PAPER_TEXT)
+
+
 def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
     """Run ``python -m cosim ARGS`` against this checkout."""
     env = dict(os.environ)
@@ -39,7 +49,7 @@ def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProces
     [
         ((), ["modes", "run", "docs/scenario.md", "examples:"]),
         (("modes",), ["SCENARIO", "--count", "--json", "--plot", "examples:"]),
-        (("run",), ["SCENARIO", "--out", "paper-double-tee", "examples:"]),
+        (("run",), ["SCENARIO", "--out", "--force", "--quiet", "paper-double-tee", "examples:"]),
     ],
     ids=["cosim", "modes", "run"],
 )
@@ -96,10 +106,28 @@ def test_main_returns_status_instead_of_exiting(tmp_path: Path, capsys: pytest.C
 
 
 def test_unwritable_output_fails_before_the_work(tmp_path: Path) -> None:
-    result = cosim_cli("run", "--out", str(tmp_path / "no-such-dir" / "summary.json"))
+    static = tmp_path / "static.toml"
+    static.write_text(PAPER_STATIC_TEXT, encoding="utf-8")
+    result = cosim_cli("run", str(static), "--out", str(tmp_path / "no-such-dir" / "summary.json"))
     assert result.returncode == 2
     assert "does not exist" in result.stderr
     assert result.stdout == ""
+    # With vehicles, --out is the sensor CSV: its folder is created, unless a file is in the way.
+    (tmp_path / "a-file").write_text("", encoding="utf-8")
+    result = cosim_cli("run", "--out", str(tmp_path / "a-file" / "run.csv"))
+    assert result.returncode == 2
+    assert result.stderr.strip() == (
+        f"cosim: error: {tmp_path / 'a-file' / 'run.csv'}: cannot create the folder for the sensor CSV: "
+        f"{str(tmp_path / 'a-file')!r} is a file"
+    )
+    assert result.stdout == ""
+
+
+def test_mcap_output_is_not_implemented_yet(tmp_path: Path) -> None:
+    result = cosim_cli("run", "--out", str(tmp_path / "run.mcap"))
+    assert result.returncode == 2
+    assert "MCAP logs are not implemented yet" in result.stderr
+    assert not (tmp_path / "run.mcap").exists()
 
 
 # --------------------------------------------------------------------------- results
@@ -133,13 +161,16 @@ def test_modes_table_and_plot(tmp_path: Path) -> None:
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_run_default_scenario_writes_summary(tmp_path: Path) -> None:
+def test_run_without_vehicles_writes_the_static_summary(tmp_path: Path) -> None:
+    static = tmp_path / "paper-static.toml"
+    static.write_text(PAPER_STATIC_TEXT.replace('name = "paper-double-tee"', 'name = "paper-static"'), encoding="utf-8")
     out = tmp_path / "summary.json"
-    result = cosim_cli("run", "--out", str(out))
+    result = cosim_cli("run", str(static), "--out", str(out), cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert "not implemented yet" in result.stdout
+    assert "the scenario has no [[vehicles]]" in result.stdout
+    assert not (tmp_path / "runs").exists()  # no time simulation, no CSV
     summary = json.loads(out.read_text(encoding="utf-8"))
-    assert summary["scenario"] == "paper-double-tee"
+    assert summary["scenario"] == "paper-static"
     assert len(summary["modes"]) == 10
     cases = {case["name"]: case for case in summary["static"]}
     axis, edge = cases["axis"], cases["left_edge"]

@@ -94,6 +94,17 @@ def test_bundled_scenario_loads(name: str) -> None:
     assert sensors["node3_acc"].quantity == "acceleration"
     assert (scenario.solver.dt, scenario.solver.scheme, scenario.solver.basis) == (0.005, "newmark", "direct")
     assert scenario.solver.duration == 20.0
+    # The paper's vehicles (shared/cases/paper-double-tee.md): QC-2 enters 7.5 s (30 m) after QC-1.
+    qc1, qc2 = scenario.vehicles
+    assert (qc1.id, qc1.model, qc2.id, qc2.model) == ("QC-1", "quarter-car", "QC-2", "quarter-car")
+    assert qc1.parameters == {"m_v": 1000.0, "m_w": 100.0, "k_v": 39478.40, "c_v": 5026.55}
+    assert qc2.parameters == {"m_v": 2000.0, "m_w": 200.0, "k_v": 78956.80, "c_v": 10053.10}
+    for qc in (qc1, qc2):
+        assert (qc.y, qc.speed, qc.direction, qc.profile) == (3.325, 4.0, "+x", None)
+    assert (qc1.entry_time, qc2.entry_time) == (0.0, 7.5)
+    assert scenario.road.smooth
+    assert scenario.leave_time == pytest.approx(17.5)
+    assert scenario.duration == 20.0
 
 
 def test_paper_sections_differ_only_in_the_right_web() -> None:
@@ -130,10 +141,11 @@ def test_constants_scenario_with_nu_and_explicit_supports(tmp_path: Path) -> Non
 def test_scheme_defaults_fill_in() -> None:
     hht = parse_scenario(replaced('scheme = "newmark"', 'scheme = "hht"'), "hht.toml")
     assert hht.solver.hht_alpha == -0.05
-    galpha = parse_scenario(replaced('scheme = "newmark"', 'scheme = "generalized-alpha"'), "ga.toml")
-    assert galpha.solver.rho_inf == 0.8
+    assert hht.solver_settings().hht_alpha == -0.05
     modal = parse_scenario(replaced('basis = "direct"', 'basis = "modal"'), "modal.toml")
     assert modal.solver.modes == 30
+    settings = modal.solver_settings()
+    assert (settings.scheme, settings.basis, settings.modes, settings.cutoff_hz) == ("newmark", "modal", 30, None)
 
 
 def test_scenario_name_defaults_to_the_file_stem(tmp_path: Path) -> None:
@@ -328,14 +340,216 @@ MALFORMED = [
     pytest.param(
         PAPER_TEXT + '\n[traffic]\nsumocfg = "net.sumocfg"\n',
         "traffic",
-        ["not supported yet", "expected one of: name, description, bridge, sensors, solver"],
+        ["not supported yet", "expected one of: name, description, bridge, sensors, vehicles, road, solver, output"],
         id="future-section-traffic",
     ),
     pytest.param(
+        replaced('scheme = "newmark"', 'scheme = "generalized-alpha"'),
+        "solver.scheme",
+        ['unknown scheme "generalized-alpha"', "expected one of: newmark, hht"],
+        id="generalized-alpha-not-implemented",
+    ),
+    pytest.param(
+        replaced("dt = 0.005", "dt = 0.005\nrho_inf = 0.8"),
+        "solver.rho_inf",
+        ["unknown key", "expected one of: dt, scheme, hht_alpha, basis, modes, cutoff_hz, duration, gravity"],
+        id="rho-inf-not-implemented",
+    ),
+    pytest.param(
+        replaced("duration = 20.0", "duration = 0.001"),
+        "solver.duration",
+        ["must be >= dt = 0.005 s (got 0.001)"],
+        id="duration-shorter-than-dt",
+    ),
+    # [[vehicles]]
+    pytest.param(
+        replaced("speed = 4.0", "sped = 4.0"),
+        "vehicles[0].sped",
+        ['unknown key; did you mean "speed"?', "expected one of: id, model, mass, m_v"],
+        id="misspelled-vehicle-key",
+    ),
+    pytest.param(
+        replaced("m_w = 200.0", "m_w = '200'"),
+        "vehicles[1].m_w",
+        ['expected a number, got string "200"'],
+        id="vehicle-string-for-number",
+    ),
+    pytest.param(
+        replaced("m_v = 1000.0", "m_v = -1000.0"),
+        "vehicles[0].m_v",
+        ["must be a finite number > 0 (got -1000.0)"],
+        id="negative-vehicle-mass",
+    ),
+    pytest.param(
+        replaced("c_v = 10053.10", "c_v = -1.0"),
+        "vehicles[1].c_v",
+        ["must be a finite number >= 0 (got -1.0)"],
+        id="negative-suspension-damping",
+    ),
+    pytest.param(
+        replaced("y = 3.325                                   # m\nspeed", "y = 6.7\nspeed"),
+        "vehicles[0].y",
+        ["must lie on the deck, -6.655 <= y <= 6.655 m (got 6.7)"],
+        id="vehicle-off-the-deck",
+    ),
+    pytest.param(
+        replaced('model = "quarter-car"', 'model = "quater-car"'),
+        "vehicles[0].model",
+        ['unknown vehicle model "quater-car"; did you mean "quarter-car"?',
+         "expected one of: moving-force, quarter-car, tyre-quarter-car, golden-car"],
+        id="unknown-vehicle-model",
+    ),
+    pytest.param(
+        replaced("c_v = 10053.10", "c_v = 10053.10\nk_t = 1e6"),
+        "vehicles[1].k_t",
+        ['not a parameter of model "quarter-car" (its parameters: m_v, m_w, k_v, c_v)'],
+        id="parameter-of-another-model",
+    ),
+    pytest.param(
+        replaced("k_v = 39478.40", ""),
+        "vehicles[0].k_v",
+        ['required key is missing (model "quarter-car" needs m_v, m_w, k_v, c_v)'],
+        id="missing-vehicle-parameter",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "speed = 0.0"),
+        "vehicles[0].speed",
+        ["must be > 0 (got 0.0)"],
+        id="zero-speed",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", ""),
+        "vehicles[0].speed",
+        ["required key is missing", "speed profile"],
+        id="missing-speed",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "speed = 4.0\nprofile = [[0, 4.0]]"),
+        "vehicles[0].speed",
+        ["give either speed or profile, not both"],
+        id="speed-and-profile",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "profile = [[0, 4.0], [5.0, 3.0], [4.0, 3.0]]"),
+        "vehicles[0].profile[2][0]",
+        ["times must increase (got 4.0 after 5.0)"],
+        id="profile-decreasing-times",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "profile = [[1.0, 4.0]]"),
+        "vehicles[0].profile[0][0]",
+        ["the first time must be 0"],
+        id="profile-not-starting-at-zero",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "profile = [[0, 4.0], [2.0, -1.0]]"),
+        "vehicles[0].profile[1][1]",
+        ["speed must be >= 0 m/s (got -1.0)"],
+        id="profile-negative-speed",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "profile = [[0, 4.0, 1.0]]"),
+        "vehicles[0].profile[0]",
+        ["expected a pair [t, v]"],
+        id="profile-not-pairs",
+    ),
+    pytest.param(
+        replaced("entry_time = 7.5", "entry_time = -7.5"),
+        "vehicles[1].entry_time",
+        ["must be >= 0 (got -7.5)"],
+        id="negative-entry-time",
+    ),
+    pytest.param(
+        replaced('direction = "+x"', 'direction = "backwards"'),
+        "vehicles[0].direction",
+        ['unknown direction "backwards"', "expected one of: +x, -x"],
+        id="unknown-direction",
+    ),
+    pytest.param(
+        replaced('id = "QC-2"', 'id = "QC-1"'),
+        "vehicles[1].id",
+        ['duplicate vehicle id "QC-1" (also vehicles[0]'],
+        id="duplicate-vehicle-id",
+    ),
+    pytest.param(
+        replaced('id = "QC-2"', 'id = "QC 2"'),
+        "vehicles[1].id",
+        ["may contain only letters, digits"],
+        id="vehicle-id-with-space",
+    ),
+    pytest.param(
+        replaced("speed = 4.0", "profile = [[0, 4.0], [5.0, 0.0]]").replace("duration = 20.0", "", 1),
+        "solver.duration",
+        ["required key is missing", "vehicles[0] (QC-1) stops on the deck at x = 10 m"],
+        id="vehicle-stops-without-duration",
+    ),
+    pytest.param(
         PAPER_TEXT + '\n[[vehicles]]\nmodel = "quarter-car"\n',
-        "vehicles",
-        ["not supported yet"],
-        id="future-section-vehicles",
+        "vehicles[2].y",
+        ["required key is missing"],
+        id="incomplete-vehicle",
+    ),
+    # [road]
+    pytest.param(
+        replaced('class = "smooth"', 'class = "C"'),
+        "road.seed",
+        ["required key is missing", "needs a seed"],
+        id="road-class-without-seed",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'class = "c"\nseed = 1'),
+        "road.class",
+        ['unknown road class "c"; did you mean "C"?', "expected one of: A, B, C, D, E, F, G, H, smooth"],
+        id="unknown-road-class",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'class = "smooth"\nseed = 1'),
+        "road.seed",
+        ['only used with a random road'],
+        id="seed-with-smooth-road",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'class = "B"\nseed = -1'),
+        "road.seed",
+        ["must be >= 0 (got -1)"],
+        id="negative-seed",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'class = "B"\nseed = 1.5'),
+        "road.seed",
+        ["expected an integer", "1.5"],
+        id="float-seed",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'profile = "no-such-road.csv"'),
+        "road.profile",
+        ["file not found", "no-such-road.csv", "relative to the scenario file's folder"],
+        id="road-profile-file-missing",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'class = "A"\nseed = 1\nprofile = "road.csv"'),
+        "road",
+        ["give either class or profile, not both"],
+        id="road-class-and-profile",
+    ),
+    pytest.param(
+        replaced('class = "smooth"', 'klass = "smooth"'),
+        "road.klass",
+        ['did you mean "class"?', "expected one of: class, seed, profile"],
+        id="misspelled-road-key",
+    ),
+    # [output]
+    pytest.param(
+        replaced("every = 1 ", "every = 0 "),
+        "output.every",
+        ["must be >= 1 (got 0)"],
+        id="output-every-zero",
+    ),
+    pytest.param(
+        replaced("every = 1 ", 'mcap = "run.mcap"\nevery = 1 '),
+        "output.mcap",
+        ["unknown key", "expected one of: csv, every"],
+        id="output-mcap-not-yet",
     ),
     pytest.param(
         replaced('start = [-6.655, 0.0]', 'start = [-6.655]'),
@@ -429,3 +643,185 @@ def test_build_bridge_from_constants(tmp_path: Path) -> None:
     assert bridge.modes(count=3).f_hz[0] > 0
     with pytest.raises(dataclasses.FrozenInstanceError):
         bridge.alpha = 1.0  # type: ignore[misc]
+
+
+# --------------------------------------------------------------------------- vehicles, road, output
+
+# CONSTANTS_TEXT (22 m, deck -3 <= y <= 3) with one vehicle of every model.
+VEHICLES_TEXT = CONSTANTS_TEXT + """\
+[[vehicles]]
+model = "moving-force"
+mass = 5000
+y = 1.0
+speed = 11.0
+[[vehicles]]
+id = "qc"
+model = "quarter-car"
+m_v = 1000
+m_w = 100
+k_v = 39478.4
+c_v = 5026.55
+y = -1.0
+speed = 5.5
+entry_time = 1.0
+direction = "-x"
+[[vehicles]]
+model = "tyre-quarter-car"
+m_v = 400
+m_w = 40
+k_v = 2.5e4
+c_v = 2.4e3
+k_t = 2.6e5
+y = 1.0
+profile = [[0, 2.0], [2.0, 4.0]]
+[[vehicles]]
+model = "golden-car"
+m_v = 300
+y = 2.5
+speed = 22.0
+"""
+
+
+def test_every_vehicle_model_loads_and_builds(tmp_path: Path) -> None:
+    from cosim.vehicles import MovingForce, QuarterCar, TyreQuarterCar
+
+    scenario = load_scenario(write(tmp_path, VEHICLES_TEXT, "cars.toml"))
+    assert [v.id for v in scenario.vehicles] == ["V1", "qc", "V3", "V4"]  # default ids by position
+    models = [v.to_model() for v in scenario.vehicles]
+    assert models[0] == MovingForce(mass=5000.0)
+    assert models[1] == QuarterCar(m_v=1000.0, m_w=100.0, k_v=39478.4, c_v=5026.55)
+    assert models[2] == TyreQuarterCar(m_v=400.0, m_w=40.0, k_v=2.5e4, c_v=2.4e3, k_t=2.6e5, c_t=0.0)  # c_t default
+    assert models[3] == TyreQuarterCar.golden_car(300.0)
+    assert scenario.vehicles[2].parameters["c_t"] == 0.0
+    assert scenario.vehicles[0].direction == "+x" and scenario.vehicles[0].entry_time == 0.0  # defaults
+    assert scenario.vehicles[2].profile == ((0.0, 2.0), (2.0, 4.0))
+
+
+def test_build_vehicles_places_them_on_the_bridge(tmp_path: Path) -> None:
+    scenario = load_scenario(write(tmp_path, VEHICLES_TEXT, "cars.toml"))
+    traffic = scenario.build_vehicles()
+    assert traffic.length == 22.0
+    assert [v.id for v in traffic.vehicles] == ["V1", "qc", "V3", "V4"]
+    assert [v.direction for v in traffic.vehicles] == [1, -1, 1, 1]
+    frame = traffic.frame(1.5)
+    on_deck = dict(zip(frame.ids, frame.x))
+    assert on_deck["V1"] == pytest.approx(16.5)
+    assert on_deck["qc"] == pytest.approx(22.0 - 5.5 * 0.5)  # "-x" enters at x = L
+    assert frame.v[frame.ids.index("qc")] == pytest.approx(-5.5)
+    assert on_deck["V3"] == pytest.approx(2.0 * 1.5 + 0.5 * 1.0 * 1.5**2)  # speed 2 m/s rising by 1 m/s^2
+
+
+def test_default_duration_is_the_last_exit_plus_two_seconds(tmp_path: Path) -> None:
+    scenario = load_scenario(write(tmp_path, VEHICLES_TEXT, "cars.toml"))
+    assert scenario.solver.duration is None
+    # qc: enters at 1 s, 22 m at 5.5 m/s -> leaves at 5 s; V3: 6 m in the first 2 s, then 16 m at 4 m/s -> 6 s.
+    assert scenario.leave_time == pytest.approx(6.0)
+    assert scenario.leave_time == pytest.approx(scenario.build_vehicles().end_time())
+    assert scenario.duration == pytest.approx(8.0)
+    given = parse_scenario(VEHICLES_TEXT + "[solver]\nduration = 3.0\n")
+    assert given.duration == 3.0
+
+
+def test_a_vehicle_stopping_after_the_deck_needs_no_duration(tmp_path: Path) -> None:
+    text = CONSTANTS_TEXT + (
+        '[[vehicles]]\nmodel = "moving-force"\nmass = 1e3\ny = 0\nprofile = [[0, 4.0], [20.0, 0.0]]\n'
+    )
+    scenario = parse_scenario(text)
+    # distance 4 t - 0.1 t^2 reaches 22 m at t = (4 - sqrt(16 - 8.8)) / 0.2, before it stops at 40 m.
+    leave = (4.0 - (16.0 - 8.8) ** 0.5) / 0.2
+    assert scenario.leave_time == pytest.approx(leave, abs=1e-6)
+    assert scenario.duration == pytest.approx(leave + 2.0, abs=1e-6)
+
+
+def test_duration_without_vehicles_must_be_given() -> None:
+    scenario = parse_scenario(CONSTANTS_TEXT, "static.toml")
+    assert scenario.vehicles == () and scenario.leave_time is None
+    with pytest.raises(ConfigError, match=r"^static.toml: solver.duration: required key is missing"):
+        scenario.duration
+
+
+def test_random_road_has_one_seeded_profile_per_wheel_path(tmp_path: Path) -> None:
+    text = VEHICLES_TEXT + '[road]\nclass = "C"\nseed = 42\n'
+    scenario = load_scenario(write(tmp_path, text, "rough.toml"))
+    assert (scenario.road.road_class, scenario.road.seed) == ("C", 42)
+    road = scenario.build_road()
+    assert road.path_y == (-1.0, 1.0, 2.5) == scenario.wheel_paths()
+    assert road.x0 == -10.0
+    assert road.x0 + road.dx * (road.r.shape[1] - 1) >= 22.0 + 10.0
+    assert "class C" in road.description and "seed 42" in road.description
+    again = scenario.build_road()
+    assert (road.r == again.r).all()  # reproducible from the recorded seed
+    assert not (road.r[0] == road.r[1]).all()  # independent paths
+
+
+def test_smooth_road_by_default_and_by_name() -> None:
+    for text in (CONSTANTS_TEXT, CONSTANTS_TEXT + '[road]\nclass = "smooth"\n'):
+        scenario = parse_scenario(text)
+        assert scenario.road.smooth and not scenario.road.random
+        assert scenario.build_road().description == "smooth"
+
+
+def test_road_profile_file_is_relative_to_the_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    folder = tmp_path / "site"
+    folder.mkdir()
+    rows = "".join(f"{x},{1e-4 * x}\n" for x in range(-1, 24))  # r = 1e-4 x for -1 <= x <= 23 m
+    (folder / "road.csv").write_text("x,r\n" + rows, encoding="utf-8")
+    path = write(folder, VEHICLES_TEXT + '[road]\nprofile = "road.csv"\n', "bridge.toml")
+    monkeypatch.chdir(tmp_path)  # not the scenario's folder
+    scenario = load_scenario(path)
+    assert scenario.road_profile_path == folder / "road.csv"
+    road = scenario.build_road()
+    assert road.path_y == (-1.0, 1.0, 2.5)
+    r, _ = road.evaluate([-1.0, 1.0, 2.5], [10.0, 10.0, 10.0])
+    assert r == pytest.approx([1e-3, 1e-3, 1e-3])  # the same profile on every path
+
+
+@pytest.mark.parametrize(
+    ("content", "fragments"),
+    [
+        ("x,r\n0.0,0.0\n10.0,0.001\n", ["the profile covers 0 <= x <= 10 m", "must cover the deck, 0 <= x <= 22 m"]),
+        ("x,r\n0.0,0.0\n__import__('os').system('true'),0\n30,0\n", ["line 3: expected two numbers"]),
+        ("x,r\n0.0,0.0\n30,0\n20,0\n", ["x must be finite and strictly increasing"]),
+    ],
+    ids=["too-short", "not-a-number", "x-decreasing"],
+)
+def test_bad_road_profile_file(tmp_path: Path, content: str, fragments: list[str]) -> None:
+    (tmp_path / "road.csv").write_text(content, encoding="utf-8")
+    path = write(tmp_path, CONSTANTS_TEXT + '[road]\nprofile = "road.csv"\n')
+    first = config_error(path).splitlines()[0]
+    assert first.startswith(f"{path}: road.profile: "), first
+    for fragment in fragments:
+        assert fragment in first, (fragment, first)
+
+
+def test_output_defaults_and_csv_path(tmp_path: Path) -> None:
+    scenario = parse_scenario(CONSTANTS_TEXT)
+    assert (scenario.output.csv, scenario.output.every) == (None, 1)
+    assert scenario.csv_path == Path("runs") / "small.csv"
+    unnamed = load_scenario(write(tmp_path, CONSTANTS_TEXT.replace('name = "small"', 'name = "my bridge/2"')))
+    assert unnamed.csv_path == Path("runs") / "my_bridge_2.csv"
+    given = parse_scenario(CONSTANTS_TEXT + '[output]\ncsv = "out/run1.csv"\nevery = 4\n')
+    assert (given.csv_path, given.output.every) == (Path("out/run1.csv"), 4)
+
+
+def test_sensors_core_and_solver_settings() -> None:
+    from cosim.simulation import Sensor, SolverSettings
+
+    scenario = parse_scenario(CONSTANTS_TEXT + '[solver]\ndt = 0.01\nscheme = "hht"\nhht_alpha = -0.1\ngravity = 9.8\n')
+    assert scenario.sensors_core() == [Sensor(name="mid", x=5.0, y=-3.0, quantity="displacement")]
+    assert scenario.solver_settings() == SolverSettings(
+        dt=0.01, scheme="hht", hht_alpha=-0.1, basis="direct", modes=None, cutoff_hz=None, gravity=9.8
+    )
+
+
+def test_simulate_runs_the_scenario(tmp_path: Path) -> None:
+    text = VEHICLES_TEXT + '[road]\nclass = "B"\nseed = 1\n[solver]\ndt = 0.01\nduration = 2.0\n[output]\nevery = 2\n'
+    scenario = load_scenario(write(tmp_path, text, "cars.toml"))
+    seen: list[float] = []
+    result = scenario.simulate(progress=seen.append)
+    assert result.steps == 200
+    assert len(result.t) == 101 and result.t[-1] == pytest.approx(2.0)  # every 2nd step and t = 0
+    assert list(result.sensors) == ["mid"]
+    assert set(result.vehicle_ids) == {"V1", "qc", "V3", "V4"}
+    assert seen and seen[-1] == 1.0
+    assert result.factorizations == 1

@@ -1,0 +1,244 @@
+"""``cosim run`` with scripted vehicles: the time simulation, its CSV and its summary."""
+from __future__ import annotations
+
+import csv
+import io
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import cosim
+from cosim import cli
+from cosim.errors import ModelError
+from cosim.scenario import Scenario
+
+REPO = Path(cosim.__file__).resolve().parents[1]
+
+
+def cosim_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m cosim ARGS`` against this checkout in ``cwd``."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    return subprocess.run(
+        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
+    )
+
+# A 20 m single span with explicit constants and 8 elements (fast to build and
+# run): a quarter-car along +x and a golden car along -x on a class H road
+# (very rough: the light wheels lose contact), sampled every 5th step. No
+# duration: the run lasts until the last vehicle leaves (2.0 s) + 2 s.
+TWO_CARS = """\
+name = "two-cars"
+[bridge]
+spans = [20.0]
+elements_per_span = 8
+supports = ["pinned", "fork"]
+[bridge.material]
+E = 30e9
+nu = 0.2
+rho = 2500
+[bridge.section.constants]
+A = 2.0
+I_y = 0.5
+I_z = 8.0
+J = 0.2
+deck_y = [-3.0, 3.0]
+[bridge.damping]
+ratios = [0.02, 0.02]
+modes = ["vertical-1", "torsion-1"]
+[[sensors]]
+name = "mid"
+x = 10.0
+[[sensors]]
+name = "mid_left_acc"
+x = 10.0
+y = 2.0
+quantity = "acceleration"
+[[vehicles]]
+model = "quarter-car"
+m_v = 1000.0
+m_w = 100.0
+k_v = 4e4
+c_v = 5e3
+y = 1.5
+speed = 10.0
+[[vehicles]]
+model = "golden-car"
+m_v = 300.0
+y = -1.5
+speed = 25.0
+entry_time = 0.5
+direction = "-x"
+[road]
+class = "H"
+seed = 7
+[solver]
+dt = 0.002
+[output]
+every = 5
+"""
+STEPS = 2000  # 4 s at 2 ms
+ROWS = STEPS // 5 + 1  # every 5th step, and t = 0
+
+
+def scenario_file(tmp_path: Path, text: str = TWO_CARS, name: str = "two-cars.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def read_csv(path: Path) -> tuple[list[str], list[list[float]]]:
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    return rows[0], [[float(v) for v in row] for row in rows[1:]]
+
+
+def test_two_vehicles_end_to_end(tmp_path: Path) -> None:
+    path = scenario_file(tmp_path)
+    result = cosim_cli("run", str(path), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "Traceback" not in result.stderr
+    # The light progress display (stderr is not a terminal here).
+    assert re.search(r"Simulating 4 s:( \d+%)+ 100%", result.stderr), result.stderr
+
+    header, rows = read_csv(tmp_path / "runs" / "two-cars.csv")  # default [output].csv
+    assert header == ["t", "mid", "mid_left_acc"]
+    assert len(rows) == ROWS
+    assert rows[0] == [0.0, 0.0, 0.0]
+    assert rows[1][0] == pytest.approx(0.01) and rows[-1][0] == pytest.approx(4.0)
+
+    out = result.stdout
+    assert "V1  quarter-car" in out and "V2  golden-car" in out  # default ids
+    assert "duration 4 s (last vehicle leaves the deck at 2 s, + 2 s)" in out
+    events = re.search(r"^Lift-off events: (\d+) \((\d+) vehicle-steps", out, flags=re.M)
+    assert events is not None, out
+    assert int(events[1]) > 0 and int(events[2]) >= int(events[1])  # a class H road lifts the wheels
+    assert re.search(rf"^Time stepping: {STEPS} steps in [0-9.]+ s wall time; real-time factor [0-9.e+]+ "
+                     r"\(simulated time / wall time\)$", out, flags=re.M), out
+    assert re.search(r"^Effective-matrix factorisations: 1 \(direct basis", out, flags=re.M), out
+    vehicle_rows = {line.split()[0]: line for line in out.splitlines() if re.match(r"  V\d ", line)}
+    assert vehicle_rows["V1"].split()[1:4] == ["0.010", "-", "2.000"]  # on the deck, sampled every 10 ms
+    assert vehicle_rows["V1"].endswith("yes")
+    sensors = {line.split()[0]: line.split() for line in out.splitlines() if line.startswith("  mid")}
+    assert sensors["mid"][-1] == "mm" and sensors["mid_left_acc"][-1] == "m/s^2"
+    mid_mm = [1e3 * row[1] for row in rows]
+    assert float(sensors["mid"][-3]) == pytest.approx(min(mid_mm), rel=1e-3)
+    assert float(sensors["mid"][-2]) == pytest.approx(max(mid_mm), rel=1e-3)
+    assert f"Wrote {ROWS} rows to {Path('runs') / 'two-cars.csv'}" in out
+
+
+def test_default_run_is_the_papers_two_quarter_cars(tmp_path: Path) -> None:
+    result = cosim_cli("run", "--quiet", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""  # --quiet: no progress display
+    assert "QC-1  quarter-car" in result.stdout and "QC-2  quarter-car" in result.stdout
+    assert "Lift-off events: 0 " in result.stdout  # a smooth road
+    header, rows = read_csv(tmp_path / "runs" / "paper-double-tee.csv")
+    assert header == ["t", "node1", "node2", "node3", "node3_acc"]
+    assert len(rows) == 4001 and rows[-1][0] == pytest.approx(20.0)
+    # Both cars drive at y = +3.325 (left of the axis): the deck twists, the
+    # left edge (node2) deflects most, the axis (node1) least.
+    low = {name: min(row[i] for row in rows) for i, name in enumerate(header) if i}
+    assert low["node2"] < low["node3"] < low["node1"] < 0
+
+
+# --------------------------------------------------------------------------- in process
+
+
+def run_main(*args: str) -> int:
+    return cli.main(["run", *args])
+
+
+def test_refuses_to_overwrite_without_force(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = scenario_file(tmp_path)
+    out = tmp_path / "deep" / "er" / "run.csv"
+    assert run_main(str(path), "--out", str(out), "--quiet") == 0  # folders created
+    first = out.read_text(encoding="utf-8")
+    capsys.readouterr()
+
+    out.write_text("keep me\n", encoding="utf-8")
+    assert run_main(str(path), "--out", str(out)) == 2
+    captured = capsys.readouterr()
+    assert captured.err == (
+        f"cosim: error: {out}: already exists; use --force to overwrite it, or --out to write elsewhere\n"
+    )
+    assert captured.out == ""  # refused before the work
+    assert out.read_text(encoding="utf-8") == "keep me\n"
+
+    assert run_main(str(path), "--out", str(out), "--force", "--quiet") == 0
+    assert out.read_text(encoding="utf-8") == first  # the same run, the same numbers
+    assert not out.with_name("run.csv.part").exists()
+
+
+def test_output_csv_from_the_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                      capsys: pytest.CaptureFixture[str]) -> None:
+    text = TWO_CARS.replace("every = 5", 'csv = "results/cars.csv"\nevery = 100')
+    path = scenario_file(tmp_path, text)
+    monkeypatch.chdir(tmp_path)
+    assert run_main(str(path), "--quiet") == 0
+    header, rows = read_csv(tmp_path / "results" / "cars.csv")  # relative to the current folder
+    assert len(rows) == STEPS // 100 + 1
+    assert "contact force, compression positive (sampled)" in capsys.readouterr().out
+
+
+def test_vehicle_entering_after_the_run_is_reported(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    text = TWO_CARS.replace("entry_time = 0.5", "entry_time = 5.0").replace("dt = 0.002", "dt = 0.002\nduration = 1.0")
+    path = scenario_file(tmp_path, text)
+    assert run_main(str(path), "--out", str(tmp_path / "o.csv"), "--quiet") == 0
+    assert "V2  not on the deck during the run" in capsys.readouterr().out
+
+
+def test_divergence_exits_1_without_csv(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
+    def diverge(self: Scenario, progress=None, *, bridge=None):  # noqa: ANN001, ANN202
+        raise ModelError(f"{self.source}: the solution diverged at t = 1.234 s (non-finite bridge acceleration)")
+
+    monkeypatch.setattr(Scenario, "simulate", diverge)
+    path = scenario_file(tmp_path)
+    out = tmp_path / "o.csv"
+    assert run_main(str(path), "--out", str(out), "--quiet") == 1
+    err = capsys.readouterr().err
+    assert err.startswith(f"cosim: error: {path}: the solution diverged at t = 1.234 s")
+    assert "was not written" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_interrupt_exits_130_without_csv(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                         capsys: pytest.CaptureFixture[str]) -> None:
+    def interrupted(self: Scenario, progress=None, *, bridge=None):  # noqa: ANN001, ANN202
+        progress(0.25)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Scenario, "simulate", interrupted)
+    path = scenario_file(tmp_path)
+    out = tmp_path / "o.csv"
+    assert run_main(str(path), "--out", str(out)) == 130
+    err = capsys.readouterr().err
+    assert err.splitlines()[-1] == f"cosim: interrupted at about t = 1 s of 4 s; {out} was not written"
+    assert not out.exists()
+
+
+def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    progress = cli._Progress(20.0, show=True)
+    progress(0.5)
+    progress(1.0)
+    progress.close()
+    text = terminal.getvalue()
+    assert "Simulating" in text and "100%" in text and "20.0/20.0 s" in text
+
+    quiet = Terminal()
+    monkeypatch.setattr("sys.stderr", quiet)
+    progress = cli._Progress(20.0, show=False)
+    progress(1.0)
+    progress.close()
+    assert quiet.getvalue() == ""
