@@ -84,8 +84,8 @@ class RoadProfile:
         path = self.path_index(y)
         s = (np.asarray(x, dtype=float) - self.x0) / self.dx
         nx = self.r.shape[1]
-        s = np.clip(s, 0.0, nx - 1.000001)
-        i = s.astype(np.int64)
+        s = np.clip(s, 0.0, nx - 1.0)
+        i = np.minimum(s.astype(np.int64), nx - 2)
         f = s - i
         r = (1 - f) * self.r[path, i] + f * self.r[path, i + 1]
         r_x = (1 - f) * self.r_x[path, i] + f * self.r_x[path, i + 1]
@@ -177,8 +177,10 @@ def profile_from_csv(path: str | Path) -> RoadProfile:
     x_arr, r_arr = np.array(xs), np.array(rs)
     if np.any(np.diff(x_arr) <= 0) or not np.all(np.isfinite(x_arr)) or not np.all(np.isfinite(r_arr)):
         raise ConfigError(f"{path}: x must be finite and strictly increasing")
-    dx = float(np.min(np.diff(x_arr)))
-    grid = np.arange(x_arr[0], x_arr[-1] + 0.5 * dx, dx)
+    # Uniform grid from the first to the last x at (at most) the file's smallest spacing.
+    n = int(np.ceil((x_arr[-1] - x_arr[0]) / float(np.min(np.diff(x_arr))) - 1e-9)) + 1
+    grid = np.linspace(x_arr[0], x_arr[-1], n)
+    dx = float(grid[1] - grid[0])
     r_grid = np.interp(grid, x_arr, r_arr)
     r_x = np.gradient(r_grid, dx)
     return RoadProfile(

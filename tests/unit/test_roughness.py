@@ -69,6 +69,12 @@ def test_user_profile_from_csv(tmp_path):
     prof = profile_from_csv(path)
     r, r_x = prof.evaluate(np.zeros(2), np.array([0.5, 1.5]))
     np.testing.assert_allclose(r, [0.005, 0.005])
+    uneven = tmp_path / "uneven.csv"
+    uneven.write_text("-1,0\n10,0.011\n23,-0.013\n")
+    prof = profile_from_csv(uneven)
+    # The resampled grid keeps the whole profile: it ends exactly at the last x.
+    assert prof.x0 + prof.dx * (prof.r.shape[1] - 1) == pytest.approx(23.0)
+    np.testing.assert_allclose(prof.evaluate(np.zeros(1), np.array([23.0]))[0], [-0.013])
     bad = tmp_path / "bad.csv"
     bad.write_text("x,r\n0,0\n1,__import__('os')\n")
     with pytest.raises(ConfigError, match="line 3"):
