@@ -9,6 +9,15 @@ import pytest
 
 from cosim.bridge import PointLoad, build_bridge
 from cosim.element import DOF_INDEX
+from cosim.references import (
+    cantilever_tip_load_deflection,
+    euler_bernoulli_ss_frequency_hz,
+    lateral_torsional_frequencies_hz,
+    midspan_torque_twist,
+    ss_point_load_deflection,
+    timoshenko_ss_frequency_hz,
+    torsional_frequencies_hz,
+)
 
 from _beams import STEEL, doubly_symmetric, monosymmetric, rectangle
 
@@ -39,7 +48,7 @@ def test_simply_supported_timoshenko_deflection_is_exact_at_the_load(a_over_l):
     b = L - a
     d = bridge.static([PointLoad(a, 0.0, P)]).deck_displacement(a, 0.0)
     # Timoshenko (e.g. Gere & Timoshenko, Mechanics of Materials): P a^2 b^2/(3 E I L) + P a b/(k G A L).
-    ref = P * a**2 * b**2 / (3 * E * sec.I_y * L) + P * a * b / (G * sec.A_sz * L)
+    ref = float(ss_point_load_deflection(a, a, L, P, E * sec.I_y, G * sec.A_sz))
     shear_part = P * a * b / (G * sec.A_sz * L) / ref
     assert shear_part > 0.1, "the case must exercise shear deformation"
     assert d == pytest.approx(ref, rel=NODAL_EXACT)
@@ -51,7 +60,7 @@ def test_cantilever_timoshenko_tip_deflection_is_exact():
     bridge = build_bridge([L], 8, STEEL, sec, ["fixed", "free"])
     d = bridge.static([PointLoad(L, 0.0, P)]).deck_displacement(L, 0.0)
     # Cantilever with shear: P L^3 / (3 E I) + P L / (k G A)  (Timoshenko & Gere).
-    ref = P * L**3 / (3 * E * sec.I_y) + P * L / (G * sec.A_sz)
+    ref = float(cantilever_tip_load_deflection(L, L, P, E * sec.I_y, G * sec.A_sz))
     assert d == pytest.approx(ref, rel=NODAL_EXACT)
     # Rotation at the tip: P L^2 / (2 E I) (shear adds none); theta_y = -w' for bending.
     theta_y = bridge.static([PointLoad(L, 0.0, P)]).field("theta_y", [L])[0]
@@ -71,14 +80,7 @@ def test_two_span_continuous_beam_midspan_deflection():
 # ----------------------------------------------------------- bending modes
 def _timoshenko_ss_frequency(n, L, sec):
     """Smaller root of the simply supported Timoshenko frequency equation (Han, Benaroya & Wei, JSV 1999)."""
-    k = n * np.pi / L
-    kga, ei = G * sec.A_sz, E * sec.I_y
-    # det [[kGA k^2 - rho A w^2, -kGA k], [-kGA k, EI k^2 + kGA - rho I w^2]] = 0, quadratic in w^2.
-    a = RHO * sec.A * RHO * sec.I_y
-    b = -(RHO * sec.A * (ei * k**2 + kga) + RHO * sec.I_y * kga * k**2)
-    c = kga * k**2 * (ei * k**2 + kga) - (kga * k) ** 2
-    w2 = (-b - np.sqrt(b * b - 4 * a * c)) / (2 * a)
-    return np.sqrt(w2) / (2 * np.pi)
+    return timoshenko_ss_frequency_hz(n, L, STEEL, sec)
 
 
 def test_simply_supported_timoshenko_frequencies():
@@ -87,7 +89,7 @@ def test_simply_supported_timoshenko_frequencies():
     bridge = build_bridge([L], 40, STEEL, sec, ["pinned", "fork"])
     fe = _vertical_modes(bridge)[:4]
     ref = np.array([_timoshenko_ss_frequency(n, L, sec) for n in range(1, 5)])
-    euler = np.array([(n * np.pi / L) ** 2 * np.sqrt(E * sec.I_y / (RHO * sec.A)) / (2 * np.pi) for n in range(1, 5)])
+    euler = euler_bernoulli_ss_frequency_hz(np.arange(1, 5), L, E * sec.I_y, RHO * sec.A)
     assert euler[0] / ref[0] > 1.02 and euler[3] / ref[3] > 1.3, "deep beam: shear and rotary inertia must matter"
     np.testing.assert_allclose(fe, ref, rtol=FREQ_TIMOSHENKO_40)
 
@@ -99,7 +101,7 @@ def test_slender_beam_reaches_the_euler_bernoulli_limit():
     fe = _vertical_modes(bridge)[:3]
     # Euler-Bernoulli: f_n = (n pi / L)^2 sqrt(EI / (rho A)) / (2 pi); rotary inertia lowers it by
     # about (n pi r / L)^2 / 2 < 4e-4 for n <= 3 here (Rayleigh beam).
-    euler = np.array([(n * np.pi / L) ** 2 * np.sqrt(E * sec.I_y / (RHO * sec.A)) / (2 * np.pi) for n in range(1, 4)])
+    euler = euler_bernoulli_ss_frequency_hz(np.arange(1, 4), L, E * sec.I_y, RHO * sec.A)
     np.testing.assert_allclose(fe, euler, rtol=5e-4)
     assert np.all(fe < euler)
 
@@ -139,7 +141,7 @@ def test_non_uniform_torsion_warping_free_ends():
     theta, sec, T = _midspan_torque_twist(L, 40, ["pinned", "fork"])
     lam = np.sqrt(G * sec.J / (E * sec.I_w))
     # GJ theta' - E I_w theta''' = T/2, theta = theta'' = 0 at the ends (Vlasov; Kollbrunner & Basler, Torsion, ch. 4):
-    ref = T / (2 * G * sec.J) * (L / 2 - np.tanh(lam * L / 2) / lam)
+    ref = float(midspan_torque_twist(L / 2, L, T, G * sec.J, E * sec.I_w, "free"))  # T/(2GJ) (L/2 - tanh(lam L/2)/lam)
     assert 1 < lam * L < 10, "mixed torsion regime"
     assert theta == pytest.approx(ref, rel=TORSION_STATIC)
 
@@ -147,9 +149,8 @@ def test_non_uniform_torsion_warping_free_ends():
 def test_non_uniform_torsion_warping_restrained_ends():
     L = 10.0
     theta, sec, T = _midspan_torque_twist(L, 40, ["rigid-end", "rigid-end"])
-    lam = np.sqrt(G * sec.J / (E * sec.I_w))
     # Same equation with theta = theta' = 0 at the ends (Kollbrunner & Basler):
-    ref = T / (2 * G * sec.J) * (L / 2 - 2 * np.tanh(lam * L / 4) / lam)
+    ref = float(midspan_torque_twist(L / 2, L, T, G * sec.J, E * sec.I_w, "restrained"))  # T/(2GJ) (L/2 - 2 tanh(lam L/4)/lam)
     free, _, _ = _midspan_torque_twist(L, 40, ["pinned", "fork"])
     assert theta < 0.9 * free, "restraining warping must stiffen the section noticeably"
     assert theta == pytest.approx(ref, rel=TORSION_STATIC)
@@ -161,9 +162,8 @@ def test_torsional_frequencies_with_warping():
     bridge = build_bridge([L], 40, STEEL, sec, ["pinned", "fork"])
     modal = bridge.modes(40)
     fe = np.array([f for f, k in zip(modal.f_hz, modal.kinds) if k == "torsion"])[:3]
-    k = np.arange(1, 4) * np.pi / L
-    # omega^2 = (GJ k^2 + E I_w k^4) / (rho I_p + rho I_w k^2), fork supports (DESIGN.md section 8).
-    ref = np.sqrt((G * sec.J * k**2 + E * sec.I_w * k**4) / (RHO * sec.I_ps + RHO * sec.I_w * k**2)) / (2 * np.pi)
+    # omega^2 = (GJ k^2 + E I_w k^4) / (rho I_p + rho I_w k^2), k = n pi / L, fork supports (DESIGN.md section 8).
+    ref = torsional_frequencies_hz(np.arange(1, 4), L, STEEL, sec)
     np.testing.assert_allclose(fe, ref, rtol=FREQ_FE_40)
 
 
@@ -172,17 +172,10 @@ def test_coupled_lateral_torsional_frequencies_of_a_monosymmetric_section():
     L = 10.0
     bridge = build_bridge([L], 40, STEEL, sec, ["pinned", "fork"])
     modal = bridge.modes(6)
-    refs = []
-    for n in range(1, 9):
-        k = n * np.pi / L
-        # Fork supports, sine modes in v and theta_x (Timoshenko & Gere, Theory of Elastic Stability, 5.?;
-        # Rayleigh beam: rotary inertia rho I_z k^2 and warping inertia rho I_w k^2 kept):
-        # det([[EI_z k^4 - w^2 rho(A + I_z k^2), -w^2 rho A e_z], [-w^2 rho A e_z, GJ k^2 + E I_w k^4 - w^2 rho (I_ps + I_w k^2)]]) = 0
-        k11, k22 = E * sec.I_z * k**4, G * sec.J * k**2 + E * sec.I_w * k**4
-        m11, m22, m12 = RHO * (sec.A + sec.I_z * k**2), RHO * (sec.I_ps + sec.I_w * k**2), RHO * sec.A * sec.z_s
-        w2 = np.roots([m11 * m22 - m12**2, -(k11 * m22 + k22 * m11), k11 * k22])
-        refs.extend(np.sqrt(np.sort(w2.real)) / (2 * np.pi))
-    ref = np.sort(refs)[:6]
+    # Fork supports, sine modes in v and theta_x, n = 1..8 (Timoshenko & Gere, Theory of Elastic Stability;
+    # Rayleigh beam: rotary inertia rho I_z k^2 and warping inertia rho I_w k^2 kept):
+    # det([[EI_z k^4 - w^2 rho(A + I_z k^2), -w^2 rho A e_z], [-w^2 rho A e_z, GJ k^2 + E I_w k^4 - w^2 rho (I_ps + I_w k^2)]]) = 0
+    ref = lateral_torsional_frequencies_hz(8, L, STEEL, sec)[:6]
     assert all(kind.startswith("coupled") or kind in ("lateral", "torsion") for kind in modal.kinds)
     np.testing.assert_allclose(modal.f_hz[:6], ref, rtol=FREQ_FE_40)
     # Without the offset the pair would be uncoupled: coupling must move the first frequency by > 1 %.

@@ -1,0 +1,272 @@
+"""Closed-form and independent reference solutions (DESIGN.md section 8).
+
+The one copy of every reference the verification tests (``tests/verification``)
+and ``cosim validate`` (:mod:`cosim.validation`) compare the model with. Each
+function names its source. numpy and scipy only.
+
+Sign convention as in the model: ``z`` up, a load ``P < 0`` pushes down and
+gives a negative deflection.
+"""
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from scipy.integrate import solve_ivp
+
+from .errors import ConfigError, ModelError
+from .section import Material, SectionProperties
+
+__all__ = [
+    "STEEL",
+    "rectangle_section",
+    "doubly_symmetric_section",
+    "monosymmetric_section",
+    "ss_point_load_deflection",
+    "cantilever_tip_load_deflection",
+    "euler_bernoulli_ss_frequency_hz",
+    "timoshenko_ss_frequency_hz",
+    "midspan_torque_twist",
+    "torsional_frequencies_hz",
+    "lateral_torsional_frequencies_hz",
+    "fryba_midspan_deflection",
+    "sprung_mass_modal_solution",
+]
+
+# --------------------------------------------------------------------------- test sections
+
+#: Structural steel of the verification beams.
+STEEL = Material(E=210e9, G=80e9, rho=7850.0)
+
+
+def rectangle_section(b: float, h: float, shear_factor: float = 5.0 / 6.0) -> SectionProperties:
+    """Solid b x h rectangle (b lateral, h vertical, m), centroid and shear centre at the origin.
+
+    ``shear_factor`` sets both shear areas ``k A``; a huge value removes shear
+    flexibility (the Euler-Bernoulli / Rayleigh-beam limit).
+    """
+    A = b * h
+    return SectionProperties(
+        A=A, y_c=0.0, z_c=0.0, I_y=b * h**3 / 12, I_z=h * b**3 / 12, I_yz=0.0, y_s=0.0, z_s=0.0,
+        J=0.229 * h * b**3, I_w=0.0, A_sy=shear_factor * A, A_sz=shear_factor * A, deck_y=(-b / 2, b / 2),
+    )
+
+
+def doubly_symmetric_section(I_w: float = 2.0e-6, J: float = 1.0e-6) -> SectionProperties:
+    """An I-like section with S = C (m^6, m^4), for pure torsion and bending checks."""
+    A = 0.02
+    return SectionProperties(
+        A=A, y_c=0.0, z_c=0.0, I_y=5e-4, I_z=1e-4, I_yz=0.0, y_s=0.0, z_s=0.0,
+        J=J, I_w=I_w, A_sy=0.5 * A, A_sz=0.5 * A, deck_y=(-0.3, 0.3),
+    )
+
+
+def monosymmetric_section(e_z: float = 0.1, stiff_vertical: bool = True) -> SectionProperties:
+    """Mono-symmetric (channel with horizontal web) section: S lies ``e_z`` (m) above C on the symmetry axis.
+
+    Shear areas are made huge (Euler-Bernoulli limit) and, optionally, vertical
+    bending very stiff, so that the lowest modes are the coupled lateral-torsional ones.
+    """
+    A = 0.01
+    return SectionProperties(
+        A=A, y_c=0.0, z_c=0.0, I_y=2e-3 if stiff_vertical else 4e-5, I_z=2e-5, I_yz=0.0, y_s=0.0, z_s=e_z,
+        J=5e-7, I_w=1e-8, A_sy=1e4 * A, A_sz=1e4 * A, deck_y=(-0.2, 0.2),
+    )
+
+
+# --------------------------------------------------------------------------- statics
+
+def ss_point_load_deflection(
+    x: npt.ArrayLike, a: float, L: float, P: float, EI: float, kGA: float
+) -> npt.NDArray[np.float64]:
+    """Deflection (m) of a simply supported Timoshenko beam under a point load ``P`` (N) at ``x = a``.
+
+    Bending part (Gere & Timoshenko, Mechanics of Materials, table of beam
+    deflections): ``P b x (L^2 - b^2 - x^2) / (6 EI L)`` for ``x <= a``,
+    mirrored for ``x > a``; shear part: ``P b x / (kGA L)`` for ``x <= a`` and
+    ``P a (L - x) / (kGA L)`` beyond. At the load: ``P a^2 b^2 / (3 EI L) + P a b / (kGA L)``.
+    """
+    x = np.asarray(x, dtype=float)
+    b = L - a
+    left = x <= a
+    xr = L - x  # distance from the right support
+    bending = np.where(
+        left,
+        P * b * x * (L**2 - b**2 - x**2) / (6 * EI * L),
+        P * a * xr * (L**2 - a**2 - xr**2) / (6 * EI * L),
+    )
+    shear = np.where(left, P * b * x / (kGA * L), P * a * xr / (kGA * L))
+    return bending + shear
+
+
+def cantilever_tip_load_deflection(
+    x: npt.ArrayLike, L: float, P: float, EI: float, kGA: float
+) -> npt.NDArray[np.float64]:
+    """Deflection (m) of a cantilever (fixed at x = 0) of Timoshenko type under a tip load ``P`` (N).
+
+    ``P x^2 (3 L - x) / (6 EI) + P x / (kGA)``; at the tip ``P L^3 / (3 EI) + P L / (kGA)``
+    (Timoshenko & Gere).
+    """
+    x = np.asarray(x, dtype=float)
+    return P * x**2 * (3 * L - x) / (6 * EI) + P * x / kGA
+
+
+# --------------------------------------------------------------------------- bending frequencies
+
+def euler_bernoulli_ss_frequency_hz(n: npt.ArrayLike, L: float, EI: float, m: float) -> npt.NDArray[np.float64]:
+    """``f_n = (n pi / L)^2 sqrt(EI / m) / (2 pi)``, Hz: simply supported Euler-Bernoulli beam, mass ``m`` per length."""
+    n = np.asarray(n, dtype=float)
+    return (n * np.pi / L) ** 2 * np.sqrt(EI / m) / (2 * np.pi)
+
+
+def timoshenko_ss_frequency_hz(n: npt.ArrayLike, L: float, material: Material, section: SectionProperties) -> npt.NDArray[np.float64]:
+    """Vertical bending frequencies (Hz) of a simply supported Timoshenko beam, mode numbers ``n``.
+
+    Smaller root of the frequency equation (Han, Benaroya & Wei, JSV 225, 1999):
+    ``det [[kGA k^2 - rho A w^2, -kGA k], [-kGA k, EI k^2 + kGA - rho I w^2]] = 0``,
+    ``k = n pi / L``, quadratic in ``w^2`` (shear ``A_sz``, inertia ``I_y``).
+    """
+    E, G, rho = material.E, material.G, material.rho
+    k = np.asarray(n, dtype=float) * np.pi / L
+    kga, ei = G * section.A_sz, E * section.I_y
+    a = rho * section.A * rho * section.I_y
+    b = -(rho * section.A * (ei * k**2 + kga) + rho * section.I_y * kga * k**2)
+    c = kga * k**2 * (ei * k**2 + kga) - (kga * k) ** 2
+    w2 = (-b - np.sqrt(b * b - 4 * a * c)) / (2 * a)
+    return np.sqrt(w2) / (2 * np.pi)
+
+
+# --------------------------------------------------------------------------- torsion
+
+def midspan_torque_twist(
+    x: npt.ArrayLike, L: float, T: float, GJ: float, EIw: float, warping: str
+) -> npt.NDArray[np.float64]:
+    """Twist (rad) of a beam under a torque ``T`` (N m) at mid-span, non-uniform (Vlasov) torsion.
+
+    ``GJ theta' - E I_w theta''' = T/2`` on the left half, ``lambda = sqrt(GJ / (E I_w))``
+    (Vlasov; Kollbrunner & Basler, Torsion in Structures, ch. 4), symmetric about mid-span:
+
+    - ``warping="free"`` (theta = theta'' = 0 at the ends):
+      ``theta = T/(2 GJ) (x - sinh(lambda x) / (lambda cosh(lambda L/2)))``,
+      at mid-span ``T/(2 GJ) (L/2 - tanh(lambda L/2) / lambda)``;
+    - ``warping="restrained"`` (theta = theta' = 0 at the ends):
+      ``theta = T/(2 GJ) (x + tanh(lambda L/4) (cosh(lambda x) - 1) / lambda - sinh(lambda x) / lambda)``,
+      at mid-span ``T/(2 GJ) (L/2 - 2 tanh(lambda L/4) / lambda)``.
+    """
+    x = np.asarray(x, dtype=float)
+    s = np.minimum(x, L - x)
+    lam = np.sqrt(GJ / EIw)
+    if warping == "free":
+        shape = s - np.sinh(lam * s) / (lam * np.cosh(lam * L / 2))
+    elif warping == "restrained":
+        shape = s + np.tanh(lam * L / 4) * (np.cosh(lam * s) - 1) / lam - np.sinh(lam * s) / lam
+    else:
+        raise ConfigError(f"`warping` must be 'free' or 'restrained' (got {warping!r})")
+    return T / (2 * GJ) * shape
+
+
+def torsional_frequencies_hz(n: npt.ArrayLike, L: float, material: Material, section: SectionProperties) -> npt.NDArray[np.float64]:
+    """Torsional frequencies (Hz) with fork supports (warping free), S = C.
+
+    ``omega^2 = (GJ k^2 + E I_w k^4) / (rho I_p + rho I_w k^2)``, ``k = n pi / L``
+    (Vlasov; DESIGN.md section 8), polar inertia about the shear centre.
+    """
+    E, G, rho = material.E, material.G, material.rho
+    k = np.asarray(n, dtype=float) * np.pi / L
+    w2 = (G * section.J * k**2 + E * section.I_w * k**4) / (rho * section.I_ps + rho * section.I_w * k**2)
+    return np.sqrt(w2) / (2 * np.pi)
+
+
+def lateral_torsional_frequencies_hz(
+    n_max: int, L: float, material: Material, section: SectionProperties
+) -> npt.NDArray[np.float64]:
+    """Coupled lateral-torsional frequencies (Hz), ascending, of a mono-symmetric section with fork supports.
+
+    Sine modes in ``v`` and ``theta_x`` for ``n = 1..n_max`` (two roots each), S a
+    distance ``z_s`` from C on the symmetry axis (Timoshenko & Gere, Theory of
+    Elastic Stability; Rayleigh beam: rotary inertia ``rho I_z k^2`` and warping
+    inertia ``rho I_w k^2`` kept)::
+
+        det([[EI_z k^4 - w^2 rho (A + I_z k^2), -w^2 rho A z_s],
+             [-w^2 rho A z_s, GJ k^2 + E I_w k^4 - w^2 rho (I_ps + I_w k^2)]]) = 0
+    """
+    E, G, rho = material.E, material.G, material.rho
+    out = []
+    for n in range(1, n_max + 1):
+        k = n * np.pi / L
+        k11, k22 = E * section.I_z * k**4, G * section.J * k**2 + E * section.I_w * k**4
+        m11 = rho * (section.A + section.I_z * k**2)
+        m22 = rho * (section.I_ps + section.I_w * k**2)
+        m12 = rho * section.A * section.z_s
+        w2 = np.roots([m11 * m22 - m12**2, -(k11 * m22 + k22 * m11), k11 * k22])
+        out.extend(np.sqrt(np.sort(w2.real)) / (2 * np.pi))
+    return np.sort(np.array(out))
+
+
+# --------------------------------------------------------------------------- moving loads
+
+def fryba_midspan_deflection(
+    t: npt.ArrayLike, L: float, v: float, P: float, EI: float, m: float, n_modes: int = 80
+) -> npt.NDArray[np.float64]:
+    """Mid-span deflection (m, up positive) under a constant force ``P`` (N, downward) crossing at speed ``v``.
+
+    Undamped simply supported Euler-Bernoulli beam, modal series (Fryba,
+    Vibration of Solids and Structures under Moving Loads, 1972, ch. 1),
+    valid while the force is on the beam (``0 <= t <= L / v``).
+    """
+    t = np.asarray(t, dtype=float)
+    w = np.zeros_like(t)
+    for n in range(1, n_modes + 1):
+        wn = (n * np.pi / L) ** 2 * np.sqrt(EI / m)
+        om = n * np.pi * v / L
+        qn = 2 * P / (m * L) / (wn**2 - om**2) * (np.sin(om * t) - om / wn * np.sin(wn * t))
+        w -= qn * np.sin(n * np.pi / 2)
+    return w
+
+
+def sprung_mass_modal_solution(
+    t_eval: npt.ArrayLike,
+    L: float,
+    EI: float,
+    m: float,
+    m_v: float,
+    k_v: float,
+    c_v: float,
+    v: float,
+    gravity: float = 9.81,
+    n_modes: int = 20,
+    rtol: float = 1e-10,
+    atol: float = 1e-13,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """A sprung mass crossing a simply supported Euler-Bernoulli beam: an independent modal solution.
+
+    The Yang & Yau (1997) / Biggs type benchmark: body ``m_v`` on a spring
+    ``k_v`` and damper ``c_v`` whose lower end follows the deck at the contact
+    point ``x = v t``; ``n_modes`` mass-normalised sine modes of the continuous
+    beam; the ODE is integrated by ``solve_ivp`` (DOP853). The body starts at
+    its static equilibrium on a rigid road (displacements measured from it).
+
+    Returns:
+        Mid-span deflection (m, up positive) and body acceleration (m/s^2) at ``t_eval`` (s).
+    """
+    t_eval = np.asarray(t_eval, dtype=float)
+    n = np.arange(1, n_modes + 1)
+    wn = (n * np.pi / L) ** 2 * np.sqrt(EI / m)
+    norm = np.sqrt(2 / (m * L))  # mass-normalised sine modes
+
+    def rhs(t: float, s: np.ndarray) -> np.ndarray:
+        q, qd, u, ud = s[:n_modes], s[n_modes:2 * n_modes], s[-2], s[-1]
+        x = v * t
+        phi = norm * np.sin(n * np.pi * x / L)
+        phi_x = norm * n * np.pi / L * np.cos(n * np.pi * x / L)
+        w, wd = phi @ q, phi @ qd + v * (phi_x @ q)
+        f_dyn = k_v * (u - w) + c_v * (ud - wd)
+        force = -m_v * gravity + f_dyn  # on the deck, up positive
+        return np.concatenate([qd, -wn**2 * q + phi * force, [ud, -f_dyn / m_v]])
+
+    span = (0.0, float(t_eval[-1]))
+    sol = solve_ivp(rhs, span, np.zeros(2 * n_modes + 2), t_eval=t_eval, method="DOP853", rtol=rtol, atol=atol)
+    if not sol.success:
+        raise ModelError(f"the reference ODE solve failed: {sol.message}")
+    w_mid = (norm * np.sin(n * np.pi / 2)) @ sol.y[:n_modes]
+    body_acc = np.array([rhs(t, s)[-1] for t, s in zip(sol.t, sol.y.T)])
+    return w_mid, body_acc
