@@ -184,3 +184,121 @@ class ScriptedTraffic:
             remaining = max(self.length - float(s_last), 0.0)
             latest = max(latest, veh.entry_time + t_last + remaining / veh.profile[-1][1])
         return latest
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Vehicles near the deck at one traffic-simulation step (bridge coordinates).
+
+    Attributes:
+        t: time, s (simulation time of the co-simulation, from 0).
+        ids: vehicle ids; x (m, contact point along the axis), y (m), v, a (along +x).
+        types: the vehicle type of each vehicle (key into the model table).
+    """
+
+    t: float
+    ids: tuple[str, ...]
+    x: npt.NDArray[np.float64]
+    y: npt.NDArray[np.float64]
+    v: npt.NDArray[np.float64]
+    a: npt.NDArray[np.float64]
+    types: tuple[str, ...]
+
+
+class FrameTraffic:
+    """Traffic given as frames at a fixed step (from SUMO, or replayed from a log).
+
+    Between two frames a vehicle moves with constant acceleration, as SUMO's
+    ballistic position update does: from frame k, ``x = x_k + v_k tau + a tau^2 / 2``
+    with ``a = (v_{k+1} - v_k) / step``, plus a linear correction that closes
+    any gap to ``x_{k+1}`` (a vehicle that stopped within the step), so the path
+    passes through every frame. A vehicle first seen at frame k+1 is traced
+    back along that same motion; one missing from frame k+1 (it left the
+    watched edges, arrived or was teleported) is gone for that step.
+
+    Args:
+        step: time between frames, s.
+        length: bridge length, m.
+        models: vehicle type -> vehicle model.
+    """
+
+    def __init__(self, step: float, length: float, models: dict[str, VehicleModel]) -> None:
+        if not step > 0:
+            raise ConfigError(f"traffic `step` must be > 0 s (got {step})")
+        self.step = float(step)
+        self.length = float(length)
+        self.models = models  # shared: a live source (SUMO) adds types as they appear
+        self.frames: list[Frame] = [Frame(0.0, (), *(np.zeros(0),) * 4, ())]
+        self._first = 0  # index in self.frames of frames[0]; older frames are dropped
+
+    def add_frame(self, frame: Frame) -> None:
+        """Append the next frame (its time one ``step`` after the last)."""
+        expected = self.frames[-1].t + self.step
+        if abs(frame.t - expected) > 1e-6 * self.step:
+            raise ConfigError(f"traffic frames must be {self.step} s apart (got t = {frame.t}, expected {expected})")
+        for typ in frame.types:
+            if typ not in self.models:
+                raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
+        self.frames.append(frame)
+
+    @property
+    def last_time(self) -> float:
+        return self.frames[-1].t
+
+    def _frame_at(self, k: int) -> Frame:
+        return self.frames[k - self._first]
+
+    def forget_before(self, t: float) -> None:
+        """Drop frames no longer needed for times after ``t`` (constant memory in long runs)."""
+        k_keep = int(np.floor(t / self.step + 1e-9)) - 1
+        drop = min(k_keep - self._first, len(self.frames) - 2)
+        if drop > 0:
+            del self.frames[:drop]
+            self._first += drop
+
+    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock:
+        times = np.asarray(times, dtype=float)
+        if times[-1] > self.last_time + 1e-9:
+            raise ConfigError(f"no traffic frames after t = {self.last_time} s (asked for {times[-1]} s)")
+        # Interval k covers (t_k, t_{k+1}]; a time on a frame belongs to the interval ending there.
+        k_of = np.ceil(times / self.step - 1e-9).astype(np.int64) - 1
+        k_of = np.maximum(k_of, self._first)
+        intervals = np.unique(k_of)
+        ids: list[str] = []
+        index: dict[str, int] = {}
+        pieces = []
+        for k in intervals:
+            f0, f1 = self._frame_at(int(k)), self._frame_at(int(k) + 1)
+            rows = np.flatnonzero(k_of == k)
+            prev = {vid: i for i, vid in enumerate(f0.ids)}
+            j0 = np.array([prev.get(vid, -1) for vid in f1.ids], dtype=np.int64)
+            seen = j0 >= 0
+            v1, a1, x1 = f1.v, f1.a, f1.x
+            v0 = np.where(seen, f0.v[np.maximum(j0, 0)] if len(f0.ids) else 0.0, v1 - a1 * self.step)
+            x0_traced = x1 - self.step * 0.5 * (v0 + v1)
+            x0 = np.where(seen, f0.x[np.maximum(j0, 0)] if len(f0.ids) else 0.0, x0_traced)
+            acc = (v1 - v0) / self.step
+            gap = x1 - (x0 + self.step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
+            tau = times[rows][:, None] - f0.t
+            x = x0 + v0 * tau + 0.5 * acc * tau**2 + gap * tau / self.step
+            v = v0 + acc * tau + gap / self.step
+            near = ((x >= -1e-9) & (x <= self.length + 1e-9)).any(axis=0)
+            for j in np.flatnonzero(near):
+                vid = f1.ids[j]
+                if vid not in index:
+                    index[vid] = len(ids)
+                    ids.append(vid)
+            pieces.append((rows, f1, x, v, acc, near))
+        q = len(ids)
+        X = np.full((len(times), q), -1e6)  # absent: far before the deck
+        V = np.zeros((len(times), q))
+        A = np.zeros((len(times), q))
+        Y = np.zeros(q)
+        types: list[str] = [""] * q
+        for rows, f1, x, v, acc, near in pieces:
+            for j in np.flatnonzero(near):
+                c = index[f1.ids[j]]
+                X[rows, c], V[rows, c], A[rows, c] = x[:, j], v[:, j], acc[j]
+                Y[c] = f1.y[j]
+                types[c] = f1.types[j]
+        return TrafficBlock(tuple(ids), tuple(self.models[t] for t in types), X, V, A, Y)

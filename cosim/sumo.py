@@ -1,0 +1,343 @@
+"""SUMO adapter: the only module that imports libsumo.
+
+SUMO runs at its own step; every step the adapter reads, through
+subscriptions (no per-vehicle getter calls in the loop), the vehicles near
+the bridge: position (front bumper), heading, speed,
+acceleration and type. Each vehicle becomes one quarter-car at its centre,
+half its length behind the bumper along the heading, projected onto the
+bridge axis (x along the axis from its start point, y to the left of it).
+The frames feed :class:`cosim.traffic.FrameTraffic`, which the beam sub-steps
+through with SUMO's ballistic motion between frames.
+
+``libsumo`` is a per-process singleton: one SUMO simulation per process.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from .errors import ConfigError, SumoError
+from .traffic import Frame, FrameTraffic, TrafficBlock
+from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+
+PARAM_PREFIX = "cosim."
+WATCH_MARGIN = 12.0  # m: watch edges reaching this far past the deck ends (half the longest vehicle + slack)
+
+# Defaults for vTypes without cosim.* params: body bounce frequency (Hz), damping ratio,
+# unsprung share of the gross mass. Cars ride softer than trucks.
+VCLASS_DEFAULTS: dict[str, tuple[float, float, float]] = {
+    "passenger": (1.2, 0.30, 0.10),
+    "private": (1.2, 0.30, 0.10),
+    "taxi": (1.2, 0.30, 0.10),
+    "evehicle": (1.2, 0.30, 0.10),
+    "motorcycle": (1.5, 0.30, 0.15),
+    "delivery": (1.3, 0.30, 0.11),
+    "bus": (1.5, 0.25, 0.12),
+    "coach": (1.5, 0.25, 0.12),
+    "truck": (1.8, 0.20, 0.12),
+    "trailer": (1.8, 0.20, 0.12),
+    "emergency": (1.4, 0.25, 0.12),
+}
+FALLBACK_DEFAULTS = (1.5, 0.25, 0.12)
+
+
+def bundled_networks() -> Path:
+    """Folder of the SUMO networks shipped with cosim (sumo_networks/)."""
+    return Path(str(resources.files("sumo_networks")))
+
+
+def sumo_binary() -> str:
+    """The ``sumo`` executable of the eclipse-sumo wheel (for SUMO_HOME and data files)."""
+    try:
+        import sumo  # eclipse-sumo
+
+        return str(Path(sumo.SUMO_HOME) / "bin" / "sumo")
+    except (ImportError, AttributeError):
+        return "sumo"
+
+
+@dataclass(frozen=True)
+class BridgeAxis:
+    """The bridge in network coordinates: its axis from ``start`` to ``end`` (m)."""
+
+    start: tuple[float, float]
+    end: tuple[float, float]
+
+    @property
+    def length(self) -> float:
+        return math.dist(self.start, self.end)
+
+    def unit(self) -> tuple[np.ndarray, np.ndarray]:
+        e = (np.asarray(self.end, dtype=float) - np.asarray(self.start, dtype=float)) / self.length
+        return e, np.array([-e[1], e[0]])  # along, left normal
+
+    def project(self, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Bridge coordinates (x along the axis from start, y to the left) of network points."""
+        e, n = self.unit()
+        dx, dy = px - self.start[0], py - self.start[1]
+        return dx * e[0] + dy * e[1], dx * n[0] + dy * n[1]
+
+
+def model_from_parameters(
+    type_id: str, mass: float, vclass: str, params: dict[str, str]
+) -> VehicleModel:
+    """Vehicle model of a vType from SUMO's ``mass`` and its ``cosim.*`` params (or vClass defaults).
+
+    Raises:
+        SumoError: a param is not a number or the parameters are not physical.
+    """
+    def number(key: str) -> float | None:
+        text = params.get(PARAM_PREFIX + key)
+        if text is None or text == "":
+            return None
+        try:
+            value = float(text)
+        except ValueError:
+            raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}{key}` must be a number (got {text!r})") from None
+        return value
+
+    if not (mass > 0 and math.isfinite(mass)):
+        raise SumoError(f"vType {type_id}: `mass` must be > 0 kg (got {mass})")
+    kind = params.get(PARAM_PREFIX + "model", "quarter-car")
+    f_body, zeta, share = VCLASS_DEFAULTS.get(vclass, FALLBACK_DEFAULTS)
+    m_w = number("m_w")
+    m_w = share * mass if m_w is None else m_w
+    m_v = mass - m_w
+    if not m_v > 0:
+        raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}m_w` = {m_w} kg leaves no body mass (mass = {mass} kg)")
+    omega = 2 * math.pi * f_body
+    k_v = number("k_v")
+    k_v = m_v * omega**2 if k_v is None else k_v
+    c_v = number("c_v")
+    c_v = 2 * zeta * math.sqrt(k_v * m_v) if c_v is None else c_v
+    try:
+        if kind == "moving-force":
+            return MovingForce(mass)
+        if kind == "quarter-car":
+            return QuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v)
+        if kind == "tyre-quarter-car":
+            k_t = number("k_t")
+            k_t = 10.0 * k_v if k_t is None else k_t  # a tyre ~10x stiffer than the suspension
+            return TyreQuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v, k_t=k_t, c_t=number("c_t") or 0.0)
+    except ConfigError as exc:
+        raise SumoError(f"vType {type_id}: {exc}") from None
+    raise SumoError(
+        f"vType {type_id}: param `{PARAM_PREFIX}model` must be moving-force, quarter-car or tyre-quarter-car "
+        f"(got {kind!r})"
+    )
+
+
+class SumoTraffic:
+    """Vehicles from a SUMO simulation (through libsumo), as a traffic source for the beam.
+
+    Args:
+        config: the ``.sumocfg`` to run.
+        axis: where the bridge is in the network.
+        step: SUMO's step length, s (the beam's dt must divide it).
+        begin, end: SUMO times to run, s (the co-simulation's t = 0 is ``begin``).
+        edges: edges to watch; default: every edge with a lane within
+            ``WATCH_MARGIN`` of the deck.
+        seed: SUMO's random seed (recorded in the log), or None for the config's.
+        half_width: lateral half-width of the deck, m; vehicles farther from the
+            axis are not on the bridge.
+        extra_args: further SUMO command-line options.
+    """
+
+    def __init__(
+        self,
+        config: str | os.PathLike,
+        axis: BridgeAxis,
+        step: float = 0.05,
+        begin: float = 0.0,
+        end: float = 600.0,
+        edges: Sequence[str] | None = None,
+        seed: int | None = None,
+        half_width: float = 50.0,
+        extra_args: Sequence[str] = (),
+    ) -> None:
+        self.config = Path(config)
+        if not self.config.is_file():
+            raise SumoError(f"{self.config}: SUMO config not found")
+        if not step > 0:
+            raise ConfigError(f"traffic `step` must be > 0 s (got {step})")
+        if not end > begin:
+            raise ConfigError(f"traffic `end` ({end} s) must be after `begin` ({begin} s)")
+        self.axis, self.step, self.begin, self.end = axis, float(step), float(begin), float(end)
+        self.seed, self.half_width = seed, float(half_width)
+        self._edges_wanted = tuple(edges) if edges else None
+        self.extra_args = tuple(extra_args)
+        self.edges: tuple[str, ...] = ()
+        self.models: dict[str, VehicleModel] = {}
+        self.frames: FrameTraffic | None = None
+        self.libsumo = None
+        self.sumo_steps = 0
+        self.teleports = 0
+
+    # ------------------------------------------------------------- lifecycle
+    def start(self) -> "SumoTraffic":
+        import libsumo  # the one place cosim imports libsumo
+
+        self.libsumo = libsumo
+        cmd = [
+            sumo_binary(), "-c", str(self.config),
+            "--step-length", repr(self.step),
+            "--begin", repr(self.begin), "--end", repr(self.end),
+            "--step-method.ballistic", "true",
+            "--no-step-log", "true", "--no-warnings", "true",
+            *(["--seed", str(self.seed)] if self.seed is not None else []),
+            *self.extra_args,
+        ]
+        try:
+            libsumo.start(cmd)
+        except Exception as exc:  # libsumo raises its own error types with SUMO's message
+            raise SumoError(f"{self.config}: SUMO could not load it: {_first_line(exc)}") from None
+        try:
+            self._watch()
+        except Exception:
+            self.close()
+            raise
+        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
+        return self
+
+    def close(self) -> None:
+        if self.libsumo is not None:
+            try:
+                self.libsumo.close()
+            except Exception:  # noqa: BLE001 - closing a failed simulation must not mask the first error
+                pass
+            self.libsumo = None
+
+    def __enter__(self) -> "SumoTraffic":
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def _watch(self) -> None:
+        ls = self.libsumo
+        all_edges = [e for e in ls.edge.getIDList() if not e.startswith(":")]
+        if self._edges_wanted is not None:
+            missing = [e for e in self._edges_wanted if e not in all_edges]
+            if missing:
+                raise SumoError(f"{self.config}: the network has no edge(s) {', '.join(missing)} (bridge edges)")
+            edges = list(self._edges_wanted)
+        else:
+            edges = []
+            L = self.axis.length
+            for edge in all_edges:
+                for i in range(ls.edge.getLaneNumber(edge)):
+                    shape = np.array(ls.lane.getShape(f"{edge}_{i}"))
+                    x, y = self.axis.project(shape[:, 0], shape[:, 1])
+                    # Sample the polyline densely enough to see it cross the watched box.
+                    t = np.linspace(0, 1, 50)
+                    xs = np.concatenate([np.interp(t, [0, 1], x[j:j + 2]) for j in range(len(x) - 1)])
+                    ys = np.concatenate([np.interp(t, [0, 1], y[j:j + 2]) for j in range(len(y) - 1)])
+                    inside = (xs > -WATCH_MARGIN) & (xs < L + WATCH_MARGIN) & (np.abs(ys) <= self.half_width)
+                    if inside.any():
+                        edges.append(edge)
+                        break
+            if not edges:
+                raise SumoError(
+                    f"{self.config}: no edge of the network lies on the bridge axis "
+                    f"{self.axis.start} -> {self.axis.end}; check [traffic] axis or edges"
+                )
+        tc = ls.constants
+        # Edge context subscriptions miss vehicles at some steps (their spatial query works
+        # on edge shapes, cf. eclipse-sumo/sumo#16422), so: each watched edge reports its vehicle
+        # list, and each vehicle seen there is subscribed to its own variables until it leaves.
+        for edge in edges:
+            ls.edge.subscribe(edge, [tc.LAST_STEP_VEHICLE_ID_LIST])
+        self.edges = tuple(edges)
+        self._vars = [tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE,
+                      tc.VAR_LENGTH]
+        self._watched: set[str] = set()
+
+    # --------------------------------------------------------------- stepping
+    def _model(self, type_id: str) -> None:
+        if type_id in self.models:
+            return
+        ls = self.libsumo
+        vt = ls.vehicletype
+        params = {}
+        for key in ("model", "m_w", "k_v", "c_v", "k_t", "c_t"):
+            value = vt.getParameter(type_id, PARAM_PREFIX + key)
+            if value != "":
+                params[PARAM_PREFIX + key] = value
+        self.models[type_id] = model_from_parameters(type_id, vt.getMass(type_id), vt.getVehicleClass(type_id), params)
+
+    def advance(self) -> Frame:
+        """One SUMO step; returns the frame of vehicles near the bridge."""
+        ls = self.libsumo
+        try:
+            ls.simulationStep()
+            self.teleports += ls.simulation.getStartingTeleportNumber()
+        except Exception as exc:  # noqa: BLE001 - SUMO errors come as several libsumo exception types
+            raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {_first_line(exc)}") \
+                from None
+        self.sumo_steps += 1
+        tc = ls.constants
+        present: set[str] = set()
+        for edge in self.edges:
+            present.update(ls.edge.getSubscriptionResults(edge)[tc.LAST_STEP_VEHICLE_ID_LIST])
+        for vid in present - self._watched:
+            ls.vehicle.subscribe(vid, self._vars)
+        for vid in self._watched - present:
+            try:
+                ls.vehicle.unsubscribe(vid)
+            except Exception:  # noqa: BLE001 - it arrived or was teleported away: nothing to undo
+                pass
+        self._watched = present
+        results = ls.vehicle.getAllSubscriptionResults()
+        ids, px, py, ang, spd, acc, length, types = [], [], [], [], [], [], [], []
+        for vid in sorted(present):
+            var = results.get(vid)
+            if var is None:
+                continue
+            pos = var[tc.VAR_POSITION]
+            ids.append(vid)
+            px.append(pos[0])
+            py.append(pos[1])
+            ang.append(var[tc.VAR_ANGLE])
+            spd.append(var[tc.VAR_SPEED])
+            acc.append(var[tc.VAR_ACCELERATION])
+            length.append(var[tc.VAR_LENGTH])
+            types.append(var[tc.VAR_TYPE])
+        for typ in set(types):
+            self._model(typ)
+        heading = np.radians(np.array(ang, dtype=float))
+        hx, hy = np.sin(heading), np.cos(heading)  # SUMO angle: 0 = north, clockwise
+        half = 0.5 * np.array(length, dtype=float)
+        cx, cy = np.array(px, dtype=float) - half * hx, np.array(py, dtype=float) - half * hy
+        x, y = self.axis.project(cx, cy)
+        e, _ = self.axis.unit()
+        along = hx * e[0] + hy * e[1]
+        keep = np.abs(y) <= self.half_width
+        t = self.sumo_steps * self.step
+        return Frame(
+            t=t, ids=tuple(i for i, k in zip(ids, keep) if k), x=x[keep], y=y[keep],
+            v=(np.array(spd, dtype=float) * along)[keep], a=(np.array(acc, dtype=float) * along)[keep],
+            types=tuple(ty for ty, k in zip(types, keep) if k),
+        )
+
+    def block(self, times: np.ndarray) -> TrafficBlock:
+        """Run SUMO as far as ``times`` (s from ``begin``) need and interpolate the vehicles there."""
+        if self.frames is None:
+            raise SumoError("SumoTraffic.start() was not called")
+        while self.frames.last_time < times[-1] - 1e-9:
+            if self.begin + self.frames.last_time + self.step > self.end + 1e-9:
+                raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
+            self.frames.add_frame(self.advance())
+        out = self.frames.block(times)
+        self.frames.forget_before(float(times[-1]))
+        return out
+
+
+def _first_line(exc: BaseException) -> str:
+    text = str(exc).strip() or type(exc).__name__
+    return text.splitlines()[0]
