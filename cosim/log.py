@@ -32,7 +32,9 @@ import numpy as np
 import orjson
 
 from . import __version__
-from .errors import LogError
+from .errors import ConfigError, LogError
+from .traffic import Frame, FrameTraffic
+from .vehicles import model_from_dict, model_to_dict
 
 PROFILE = "cosim"
 TOPIC_SENSORS = "/cosim/sensors"
@@ -40,6 +42,7 @@ TOPIC_VEHICLES = "/cosim/vehicles"
 TOPIC_EVENTS = "/cosim/events"
 TOPIC_STATUS = "/cosim/status"
 TOPIC_TRAFFIC = "/cosim/traffic"
+TOPIC_VEHICLE_TYPES = "/cosim/vehicle_types"
 
 STATUS_STATES = ("started", "running", "finished", "interrupted", "error")
 EVENT_KINDS = ("entered", "left", "liftoff", "touchdown")
@@ -92,6 +95,7 @@ STATUS_SCHEMA = {
 }
 TRAFFIC_SCHEMA = {
     "title": "cosim.TrafficFrame", "type": "object",
+    "description": "Vehicles near the deck at one SUMO step (bridge coordinates): what replay re-drives.",
     "properties": {
         "t": _NUMBER,
         "ids": {"type": "array", "items": {"type": "string"}},
@@ -99,9 +103,17 @@ TRAFFIC_SCHEMA = {
         "y": {"type": "array", "items": _NUMBER},
         "speed": {"type": "array", "items": _NUMBER},
         "acceleration": {"type": "array", "items": _NUMBER},
-        "models": {"type": "array", "items": {"type": "string"}},
+        "types": {"type": "array", "items": {"type": "string"}},
     },
-    "required": ["t", "ids", "x", "y", "speed", "acceleration", "models"], "additionalProperties": False,
+    "required": ["t", "ids", "x", "y", "speed", "acceleration", "types"], "additionalProperties": False,
+}
+VEHICLE_TYPE_SCHEMA = {
+    "title": "cosim.VehicleType", "type": "object",
+    "description": "The vehicle model of a SUMO vType, logged when the type first appears.",
+    "properties": {"t": _NUMBER, "type": {"type": "string"},
+                   "model": {"type": "object", "properties": {"model": {"type": "string"}},
+                             "required": ["model"], "additionalProperties": {"type": "number"}}},
+    "required": ["t", "type", "model"], "additionalProperties": False,
 }
 
 
@@ -143,28 +155,35 @@ class LogRecorder:
             (TOPIC_EVENTS, "cosim.TrafficEvent", EVENTS_SCHEMA),
             (TOPIC_STATUS, "cosim.RunStatus", STATUS_SCHEMA),
             (TOPIC_TRAFFIC, "cosim.TrafficFrame", TRAFFIC_SCHEMA),
+            (TOPIC_VEHICLE_TYPES, "cosim.VehicleType", VEHICLE_TYPE_SCHEMA),
         ):
             sid = self._writer.register_schema(title, "jsonschema", json.dumps(schema).encode())
             self._channels[topic] = self._writer.register_channel(topic, "json", sid)
         self._last_t = 0.0
+        # The block logger's thread and the traffic source (main thread) both write.
+        self._lock = threading.Lock()
 
     # --------------------------------------------------------------- content
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
         """Store an input file or a derived document (resolved parameters, modes) in the log."""
         if isinstance(data, str):
             data = data.encode()
-        self._writer.add_attachment(0, 0, name, media_type, data)
+        with self._lock:
+            self._writer.add_attachment(0, 0, name, media_type, data)
 
     def metadata(self, name: str, values: dict[str, str]) -> None:
-        self._writer.add_metadata(name, {k: str(v) for k, v in values.items()})
+        with self._lock:
+            self._writer.add_metadata(name, {k: str(v) for k, v in values.items()})
 
     def write(self, topic: str, t: float, message: dict[str, Any]) -> None:
         """One JSON message on ``topic`` at simulated time ``t`` (s)."""
         ns = to_ns(t)
-        self._sequence += 1
         # orjson: the logging budget is a fraction of a ~20 us solver step per sample.
-        self._writer.add_message(self._channels[topic], ns, orjson.dumps(message), ns, self._sequence)
-        self._last_t = t
+        data = orjson.dumps(message)
+        with self._lock:
+            self._sequence += 1
+            self._writer.add_message(self._channels[topic], ns, data, ns, self._sequence)
+            self._last_t = max(self._last_t, t)
 
     def status(self, t: float, state: str, message: str = "", progress: float | None = None,
                wall_time: float | None = None) -> None:
@@ -177,11 +196,12 @@ class LogRecorder:
             msg["wall_time"] = wall_time
         self.write(TOPIC_STATUS, t, msg)
         if state != "running":
-            self._stream.flush()
+            self.flush()
 
     def flush(self) -> None:
         """Push what the writer has finished to the operating system."""
-        self._stream.flush()
+        with self._lock:
+            self._stream.flush()
 
     # ------------------------------------------------------------- lifecycle
     def close(self, state: str = "finished", message: str = "", wall_time: float | None = None) -> None:
@@ -193,8 +213,9 @@ class LogRecorder:
         try:
             self.status(self._last_t, state, message, wall_time=wall_time)
         finally:
-            self._writer.finish()
-            self._stream.close()
+            with self._lock:
+                self._writer.finish()
+                self._stream.close()
 
     def __enter__(self) -> "LogRecorder":
         return self
@@ -442,3 +463,47 @@ class BlockLogger:
                 for i, j in enumerate(cols)
             ]
             self.rec.write(TOPIC_VEHICLES, t, {"t": t, "vehicles": vehicles})
+
+
+class TrafficLogger:
+    """Frame sink for a live traffic source (SUMO): logs every frame and each new vehicle type.
+
+    These are what :func:`traffic_from_log` needs to re-drive a bridge with
+    exactly the same vehicle kinematics (``cosim replay``).
+    """
+
+    def __init__(self, recorder: LogRecorder) -> None:
+        self.rec = recorder
+        self._types: set[str] = set()
+
+    def __call__(self, frame, models: dict) -> None:
+        for typ in frame.types:
+            if typ not in self._types:
+                self._types.add(typ)
+                self.rec.write(TOPIC_VEHICLE_TYPES, frame.t, {"t": frame.t, "type": typ,
+                                                              "model": model_to_dict(models[typ])})
+        self.rec.write(TOPIC_TRAFFIC, frame.t, {
+            "t": frame.t, "ids": list(frame.ids), "x": frame.x.tolist(), "y": frame.y.tolist(),
+            "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
+
+
+def traffic_from_log(contents: LogContents, length: float, step: float) -> FrameTraffic:
+    """Rebuild the logged traffic frames as a traffic source for a bridge of ``length`` m.
+
+    Raises:
+        LogError: the log has no traffic frames, or they are malformed.
+    """
+    frames = contents.topic(TOPIC_TRAFFIC)
+    if not frames:
+        raise LogError(f"{contents.path}: no traffic frames ({TOPIC_TRAFFIC}) in this log")
+    try:
+        models = {m["type"]: model_from_dict(m["model"]) for m in contents.topic(TOPIC_VEHICLE_TYPES)}
+        traffic = FrameTraffic(step, length, models)
+        for f in frames:
+            traffic.add_frame(Frame(
+                t=float(f["t"]), ids=tuple(f["ids"]), x=np.array(f["x"], dtype=float), y=np.array(f["y"], dtype=float),
+                v=np.array(f["speed"], dtype=float), a=np.array(f["acceleration"], dtype=float),
+                types=tuple(f["types"])))
+    except (KeyError, TypeError, ValueError, ConfigError) as exc:
+        raise LogError(f"{contents.path}: malformed traffic frames ({exc})") from None
+    return traffic

@@ -18,7 +18,7 @@ import os
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -147,6 +147,7 @@ class SumoTraffic:
         half_width: lateral half-width of the deck, m; vehicles farther from the
             axis are not on the bridge.
         extra_args: further SUMO command-line options.
+        frame_sink: called with every frame and the model table (e.g. a log's TrafficLogger).
     """
 
     def __init__(
@@ -160,6 +161,7 @@ class SumoTraffic:
         seed: int | None = None,
         half_width: float = 50.0,
         extra_args: Sequence[str] = (),
+        frame_sink: Callable[[Frame, dict[str, VehicleModel]], None] | None = None,
     ) -> None:
         self.config = Path(config)
         if not self.config.is_file():
@@ -172,6 +174,7 @@ class SumoTraffic:
         self.seed, self.half_width = seed, float(half_width)
         self._edges_wanted = tuple(edges) if edges else None
         self.extra_args = tuple(extra_args)
+        self.frame_sink = frame_sink
         self.edges: tuple[str, ...] = ()
         self.models: dict[str, VehicleModel] = {}
         self.frames: FrameTraffic | None = None
@@ -332,7 +335,10 @@ class SumoTraffic:
         while self.frames.last_time < times[-1] - 1e-9:
             if self.begin + self.frames.last_time + self.step > self.end + 1e-9:
                 raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
-            self.frames.add_frame(self.advance())
+            frame = self.advance()
+            self.frames.add_frame(frame)
+            if self.frame_sink is not None:
+                self.frame_sink(frame, self.models)
         out = self.frames.block(times)
         self.frames.forget_before(float(times[-1]))
         return out

@@ -124,3 +124,26 @@ class TyreQuarterCar:
 
 VehicleModel = Union[MovingForce, QuarterCar, TyreQuarterCar]
 MODEL_NAMES = ("moving-force", "quarter-car", "tyre-quarter-car")
+
+
+def model_to_dict(model: VehicleModel) -> dict[str, float | str]:
+    """A plain description of a vehicle model (for logs): ``{"model": kind, <parameters>}``."""
+    from dataclasses import asdict
+
+    return {"model": model.kind, **asdict(model)}
+
+
+def model_from_dict(data: dict) -> VehicleModel:
+    """Rebuild a vehicle model from :func:`model_to_dict`'s output (numbers only; validated)."""
+    kinds = {"moving-force": MovingForce, "quarter-car": QuarterCar, "tyre-quarter-car": TyreQuarterCar}
+    kind = data.get("model")
+    if kind not in kinds:
+        raise ConfigError(f"unknown vehicle model {kind!r} (expected one of: {', '.join(kinds)})")
+    params = {k: v for k, v in data.items() if k != "model"}
+    for key, value in params.items():
+        if not isinstance(value, (int, float)) or isinstance(value, bool):
+            raise ConfigError(f"vehicle model parameter `{key}` must be a number (got {value!r})")
+    try:
+        return kinds[kind](**params)
+    except TypeError as exc:
+        raise ConfigError(f"vehicle model {kind}: {exc}") from None
