@@ -1,10 +1,13 @@
 """Compiled inner loop of the coupled vehicle-bridge step (numba).
 
 Why compiled: one beam step does a few hundred small operations (contact rows,
-vehicle elimination, a rank-q update, banded solves); in numpy each costs a
-Python call of about a microsecond, which made the step ~10x slower than its
-arithmetic (benchmarks/bench_step.py measures both). The mathematics is
-documented in :mod:`cosim.coupling`; this module is its only implementation.
+vehicle elimination, a rank-q update, banded solves); written with numpy each
+cost a Python call of about a microsecond, which made the first (numpy)
+version of the step about ten times slower than its arithmetic (measured
+while developing it: ~200 us against ~20 us now for the paper bridge with
+one vehicle; benchmarks/bench_step.py times this kernel against a naive
+sparse solver and OpenSeesPy). The mathematics is documented in
+:mod:`cosim.coupling`; this module is its only implementation.
 
 Conventions shared by both bases:
 
@@ -188,7 +191,7 @@ def vehicle_update(kind, m_v, m_w, k_v, c_v, k_t, c_t, weight, vstate, speed, ac
 
 # ----------------------------------------------------------- direct basis
 @njit(cache=True)
-def _csr_matvec_add(indptr, indices, data, x, out, scale):
+def csr_matvec_add(indptr, indices, data, x, out, scale):
     """out += scale * A x for A in CSR form."""
     for i in range(out.shape[0]):
         s = 0.0
@@ -240,14 +243,14 @@ def direct_block(cb, k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat, ray_a, ray_b, ain
             tmp[j] = d_star[j] + ray_b * v_star[j]
             rhs[j] = 0.0
         # rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n, C = ray_a M + ray_b K.
-        _csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, -ca)
-        _csr_matvec_add(m_ptr, m_ind, m_dat, v_star, rhs, -ca * ray_a)
+        csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, -ca)
+        csr_matvec_add(m_ptr, m_ind, m_dat, v_star, rhs, -ca * ray_a)
         if alpha != 0.0:
             for j in range(n):
                 tmp[j] = d[j] + ray_b * v[j]
                 rhs[j] -= alpha * force_prev[j]
-            _csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, alpha)
-            _csr_matvec_add(m_ptr, m_ind, m_dat, v, rhs, alpha * ray_a)
+            csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, alpha)
+            csr_matvec_add(m_ptr, m_ind, m_dat, v, rhs, alpha * ray_a)
         elems, vals = contact_rows(X[step], Y, nodes_x, cw, ct, y_s, length)
         for i in range(q):
             e = elems[i]
