@@ -3,33 +3,39 @@
 Subcommands::
 
     cosim modes SCENARIO [--count N] [--json] [--plot FILE.png]
-    cosim run [SCENARIO] [--out CSV] [--force] [--quiet]
+    cosim run [SCENARIO] [--out LOG.mcap] [--csv OUT.csv] [--force] [--quiet]
+    cosim replay LOG.mcap [--scenario OTHER] [--out NEW.mcap] [--force] [--quiet]
+    cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--force]
+    cosim info LOG.mcap
+    cosim plot LOG.mcap [--sensor NAME ...] -o FIG.png [--force]
+
+The work is done by :mod:`cosim.runner`; this module parses and prints.
 
 Every :class:`cosim.errors.CosimError` becomes ``cosim: error: <message>`` on
 stderr and exit status 2 (as for usage errors); a :class:`cosim.errors.ModelError`
-during the time integration (the solution diverged) exits with 1; Ctrl-C exits
-with 130.
+during the time integration (the solution diverged) exits with 1 (the log then
+ends with status "error"); Ctrl-C exits with 130 (the log ends with status
+"interrupted").
 """
 from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
+import tempfile
 import textwrap
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
-from . import __version__
+from . import __version__, runner
 from .bridge import BridgeModel, ModalResult, PointLoad
-from .errors import CosimError, ModelError
+from .errors import CosimError
+from .log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
 from .scenario import Scenario, list_bundled_scenarios, load_scenario
 from .section import SectionProperties
-from .simulation import SimulationResult
 
 DEFAULT_SCENARIO = "paper-double-tee"
 STATIC_LOAD_N = 100e3
@@ -38,12 +44,7 @@ NO_VEHICLES = (
     "this run does the modal analysis and a static load case"
 )
 #: Summary units per sensor quantity: (unit, factor from SI).
-DISPLAY_UNITS: dict[str, tuple[str, float]] = {
-    "displacement": ("mm", 1e3),
-    "velocity": ("mm/s", 1e3),
-    "acceleration": ("m/s^2", 1.0),
-    "bending_moment": ("kN m", 1e-3),
-}
+DISPLAY_UNITS = runner.DISPLAY_UNITS
 EXIT_RUN_FAILED = 1
 EXIT_INTERRUPTED = 130
 MAX_PLOTTED_MODES = 6
@@ -51,43 +52,10 @@ NEGLIGIBLE_SHARE = 1e-3  # plotted fields below this share of the largest are dr
 
 # --------------------------------------------------------------------------- payloads
 
-
-def _jsonable(value: Any) -> Any:
-    """Plain JSON types from numpy scalars/arrays, tuples and dataclass fields."""
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if hasattr(value, "tolist"):
-        return _jsonable(value.tolist())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def _section_payload(section: SectionProperties) -> dict[str, Any]:
-    return _jsonable(asdict(section))
-
-
-def _modes_payload(modal: ModalResult) -> list[dict[str, Any]]:
-    f_hz = modal.f_hz
-    return [
-        {
-            "n": i + 1,
-            "f_hz": float(f_hz[i]),
-            "kind": modal.kinds[i],
-            "participation": {kind: float(values[i]) for kind, values in modal.participation.items()},
-        }
-        for i in range(len(f_hz))
-    ]
-
-
-def _damping_payload(bridge: BridgeModel) -> dict[str, Any]:
-    return {
-        "alpha": float(bridge.alpha),
-        "beta": float(bridge.beta),
-        "note": bridge.damping_note,
-    }
+_jsonable = runner.jsonable
+_section_payload = runner.section_payload
+_modes_payload = runner.modes_payload
+_damping_payload = runner.damping_payload
 
 
 # --------------------------------------------------------------------------- text
@@ -283,9 +251,9 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    if args.out is not None and Path(args.out).suffix.lower() == ".mcap":
+    if args.out is not None and Path(args.out).suffix.lower() == ".csv":
         raise CosimError(
-            f"{args.out}: MCAP logs are not implemented yet; give a .csv path for the sensor time histories"
+            f"{args.out}: --out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv {args.out}"
         )
     scenario = load_scenario(args.scenario)
     if scenario.vehicles:
@@ -294,7 +262,14 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _run_static(scenario: Scenario, args: argparse.Namespace) -> int:
-    """Without vehicles: the modes and a static load case; ``--out`` writes them as JSON."""
+    """Without vehicles: the modes and a static load case; ``--out`` writes them as JSON (no log)."""
+    if args.out is not None and Path(args.out).suffix.lower() == ".mcap":
+        raise CosimError(
+            f"{args.out}: the scenario has no [[vehicles]], so there is no time simulation to log; "
+            "--out writes the modes and static displacements as JSON (e.g. --out summary.json)"
+        )
+    if args.csv is not None:
+        raise CosimError(f"{args.csv}: the scenario has no [[vehicles]]: no sensor time histories for --csv")
     if args.out is not None:
         _check_output(args.out, "summary")
     print(_scenario_line(scenario))
@@ -366,34 +341,16 @@ class _Progress:
             self._tenths = None
 
 
-def _prepare_csv(path: Path, force: bool) -> None:
-    """Fail before the run when the CSV cannot be written; create its folder."""
-    if path.is_dir():
-        raise CosimError(f"{path}: is a directory, expected a file name for the sensor CSV")
-    if path.exists() and not force:
-        raise CosimError(f"{path}: already exists; use --force to overwrite it, or --out to write elsewhere")
-    blocking = next((folder for folder in reversed(path.parents) if folder.exists() and not folder.is_dir()), None)
-    if blocking is not None:
-        raise CosimError(f"{path}: cannot create the folder for the sensor CSV: {str(blocking)!r} is a file")
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise CosimError(
-            f"{path}: cannot create the folder for the sensor CSV ({exc.strerror or exc})"
-        ) from None
-
-
-def _write_csv(result: SimulationResult, path: Path, force: bool) -> None:
-    """Write through a temporary file, so a failed write leaves no half file behind."""
-    if path.exists() and not force:  # appeared during the run
-        raise CosimError(f"{path}: already exists (created during the run); use --force to overwrite it")
-    partial = path.with_name(path.name + ".part")
-    try:
-        result.write_csv(partial)
-        os.replace(partial, path)
-    except OSError as exc:
-        partial.unlink(missing_ok=True)
-        raise CosimError(f"{path}: cannot write the sensor CSV ({exc.strerror or exc})") from None
+def _log_target(out: str | None, default: Path, force: bool) -> Path:
+    """The log to write: ``out`` (must end in .mcap) or ``default``; checked before any work."""
+    if out is not None:
+        path = Path(out)
+        if path.suffix.lower() != ".mcap":
+            raise CosimError(f"{out}: the log is an MCAP file: give a path ending in .mcap")
+    else:
+        path = default
+    runner.check_new_file(path, "log", force)
+    return path
 
 
 def _g(value: float, digits: int = 6) -> str:
@@ -443,50 +400,57 @@ def _solver_line(scenario: Scenario, duration: float) -> str:
     else:
         how = f"last vehicle leaves the deck at {_g(scenario.leave_time or 0.0, 4)} s, + 2 s"
     steps = int(round(duration / solver.dt))
-    every = f", sampled every {scenario.output.every} steps" if scenario.output.every > 1 else ""
     return (f"Solver: {scheme}, {basis} basis, dt = {_g(solver.dt)} s, duration {_g(duration, 4)} s ({how}), "
-            f"{steps} steps{every}, g = {_g(solver.gravity)} m/s^2")
+            f"{steps} steps, g = {_g(solver.gravity)} m/s^2")
 
 
-def _sensor_summary(scenario: Scenario, result: SimulationResult) -> list[str]:
+def _logging_line(scenario: Scenario, log_path: Path) -> str:
+    every = scenario.output_every
+    steps = "every step" if every == 1 else f"every {every} steps"
+    return f"Log: {log_path}, sampled at {_g(scenario.output_rate_hz, 4)} Hz ({steps})"
+
+
+def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - SimulationResult
     if not scenario.sensors:
-        return ["Sensors: none (the scenario has no [[sensors]]; the CSV has only the time column)"]
+        return ["Sensors: none (the scenario has no [[sensors]]; the log has only the time of each sample)"]
     names = [s.name for s in scenario.sensors]
     width = max(len("name"), *(len(n) for n in names))
     lines = [
-        "Sensors: peaks over the run",
+        "Sensors: peaks over the run (every step)",
         f"  {'name':<{width}}  {'quantity':<14}{'x [m]':>8}{'y [m]':>8}{'min':>12}{'max':>12}  unit",
     ]
     for s in scenario.sensors:
         unit, factor = DISPLAY_UNITS[s.quantity]
-        values = result.sensors[s.name] * factor
-        lo, hi = (float(values.min()), float(values.max())) if len(values) else (0.0, 0.0)
-        lines.append(f"  {s.name:<{width}}  {s.quantity:<14}{s.x:8.3f}{s.y:8.3f}{lo:12.4g}{hi:12.4g}  {unit}")
+        lo = min(result.sensor_min.get(s.name, 0.0), 0.0) * factor  # t = 0: at rest
+        hi = max(result.sensor_max.get(s.name, 0.0), 0.0) * factor
+        lines.append(f"  {s.name:<{width}}  {s.quantity:<14}{s.x:8.3f}{s.y:8.3f}"
+                     f"{lo + 0.0:12.4g}{hi + 0.0:12.4g}  {unit}")
     return lines
 
 
-def _vehicle_summary(scenario: Scenario, result: SimulationResult) -> list[str]:
-    ids = [v.id for v in scenario.vehicles]
+def _vehicle_summary(outcome: runner.RunOutcome) -> list[str]:
+    result = outcome.result
+    ids = [v.id for v in outcome.scenario.vehicles]
     width = max(len("id"), *(len(i) for i in ids))
-    sampled = " (sampled)" if scenario.output.every > 1 else ""
     lines = [
-        f"Vehicles: contact force, compression positive{sampled}",
+        f"Vehicles: {len(outcome.on_deck)} of {len(ids)} on the deck during the run, at most {result.max_on_deck} "
+        "at once; contact force, compression positive",
         f"  {'id':<{width}}  {'on the deck [s]':<18}{'min [kN]':>10}{'max [kN]':>10}  lifted off",
     ]
     for vid in ids:
-        if vid not in result.vehicle_ids:
+        if vid not in outcome.on_deck:
             lines.append(f"  {vid:<{width}}  not on the deck during the run")
             continue
-        data = result.vehicle(vid)
-        force = data["contact_force"] / 1e3
-        t = data["t"]
-        on_deck = f"{t.min():.3f} - {t.max():.3f}"
-        lifted = "yes" if force.min() < 0 else "no"
-        lines.append(f"  {vid:<{width}}  {on_deck:<18}{force.min():10.3f}{force.max():10.3f}  {lifted}")
+        first, last = outcome.on_deck[vid]
+        lo, hi = result.contact_force_range.get(vid, (0.0, 0.0))
+        on_deck = f"{first:.3f} - {last:.3f}"
+        lifted = "yes" if lo < 0 else "no"
+        lines.append(f"  {vid:<{width}}  {on_deck:<18}{lo / 1e3:10.3f}{hi / 1e3:10.3f}  {lifted}")
     return lines
 
 
-def _run_lines(result: SimulationResult, duration: float) -> list[str]:
+def _run_lines(outcome: runner.RunOutcome) -> list[str]:
+    result, duration = outcome.result, outcome.duration
     events, steps = result.liftoff_events, result.liftoff_steps
     lines = [f"Lift-off events: {events} ({steps} vehicle-steps with a negative contact force)"]
     if events:
@@ -499,43 +463,218 @@ def _run_lines(result: SimulationResult, duration: float) -> list[str]:
     basis = result.info.get("basis", "?")
     lines.append(f"Effective-matrix factorisations: {result.factorizations} "
                  f"({basis} basis, {result.info.get('n_reduced', '?')} unknowns)")
+    lines.append(f"Wall time with logging: {outcome.wall_time:.2f} s")
     return lines
 
 
-def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
-    """With [[vehicles]]: the time simulation, the sensor CSV and a summary."""
-    csv_path = Path(args.out) if args.out is not None else scenario.csv_path
-    _prepare_csv(csv_path, args.force)
-    duration = scenario.duration
-    print(_scenario_line(scenario))
-    bridge = scenario.build_bridge()
+def _size(n: int) -> str:
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{n} B"
+
+
+def _log_done_line(outcome: runner.RunOutcome) -> str:
+    return (f"Wrote the log {outcome.log_path} ({_size(outcome.log_bytes)}; {outcome.samples} sensor samples "
+            f"at {_g(outcome.rate_hz, 4)} Hz from t = 0; status finished)")
+
+
+def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path) -> list[str]:
     spans = " + ".join(f"{span:g}" for span in bridge.spans)
-    print(f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements")
-    _print(_damping_lines(bridge))
-    _print(_vehicle_lines(scenario))
-    print(_road_line(scenario))
-    print(_solver_line(scenario, duration))
+    return [
+        f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
+        *_damping_lines(bridge),
+        *_vehicle_lines(scenario),
+        _road_line(scenario),
+        _solver_line(scenario, scenario.duration),
+        _logging_line(scenario, log_path),
+    ]
+
+
+def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, args: argparse.Namespace,
+                     **extra: Any) -> tuple[int, runner.RunOutcome | None]:
+    """The time simulation into ``log_path``: (exit status, outcome) with the failure messages printed."""
+    duration = scenario.duration
     sys.stdout.flush()
     progress = _Progress(duration, show=not args.quiet)
     try:
-        result = scenario.simulate(progress, bridge=bridge)
-    except ModelError as exc:
+        outcome = runner.run_logged(scenario, log_path, force=args.force, bridge=bridge, progress=progress, **extra)
+    except runner.RunFailed as exc:
         progress.close()
-        _report(f"{exc} (the run failed; {csv_path} was not written)")
-        return EXIT_RUN_FAILED
+        _report(f"{exc}\nthe run failed; the log {exc.log_path} is finished and ends with status \"error\"")
+        return EXIT_RUN_FAILED, None
     except KeyboardInterrupt:
         progress.close()
-        print(f"cosim: interrupted at about t = {progress.fraction * duration:.3g} s of {duration:g} s; "
-              f"{csv_path} was not written", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        where = (f"the log up to there is in {log_path} (finished, status \"interrupted\")" if log_path.exists()
+                 else "no log was written")
+        print(f"cosim: interrupted at about t = {progress.fraction * duration:.4g} s of {duration:g} s; {where}",
+              file=sys.stderr)
+        return EXIT_INTERRUPTED, None
     progress.close()
-    _write_csv(result, csv_path, args.force)
+    return 0, outcome
+
+
+def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
+    """With [[vehicles]]: the time simulation into an MCAP log, an optional sensor CSV and a summary."""
+    default = scenario.log_path or runner.unique_path(scenario.default_log_path())
+    log_path = _log_target(args.out, default, args.force)
+    csv_path = Path(args.csv) if args.csv is not None else scenario.csv_path
+    if csv_path is not None:
+        runner.check_new_file(csv_path, "sensor CSV", args.force)
+    print(_scenario_line(scenario))
+    bridge = scenario.build_bridge()
+    _print(_header_lines(scenario, bridge, log_path))
+    status, outcome = _simulate_logged(scenario, bridge, log_path, args)
+    if outcome is None:
+        return status
     print()
-    _print(_sensor_summary(scenario, result))
-    _print(_vehicle_summary(scenario, result))
-    _print(_run_lines(result, duration))
-    columns = ",".join(["t", *result.sensors])
-    print(f"Wrote {len(result.t)} rows to {csv_path} (columns {columns}; SI units: m, m/s, m/s^2, N m)")
+    _print(_sensor_summary(scenario, outcome.result))
+    _print(_vehicle_summary(outcome))
+    _print(_run_lines(outcome))
+    print(_log_done_line(outcome))
+    if csv_path is not None:
+        rows, columns = runner.export_csv(log_path, csv_path, force=args.force)
+        print(f"Wrote {rows} rows to {csv_path} (columns {','.join(columns)}; SI units: m, m/s, m/s^2, N m)")
+    return 0
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    other = load_scenario(args.scenario) if args.scenario is not None else None
+    log = Path(args.log)
+    with tempfile.TemporaryDirectory(prefix="cosim-replay-") as scratch:
+        plan = runner.replay_scenario(log, Path(scratch), other)
+        scenario = plan.scenario
+        default = runner.unique_path(scenario.default_log_path(suffix="-replay"))
+        log_path = _log_target(args.out, default, args.force)
+        if log_path.resolve() == log.resolve():
+            raise CosimError(f"{log_path}: the replay cannot overwrite the log it replays")
+        ids = ", ".join(v.id for v in scenario.vehicles)
+        status_word = runner.status_word(plan.overview)
+        print(f"Replay of {log} ({plan.record['log_scenario']}, {status_word}): "
+              f"its {len(scenario.vehicles)} scripted vehicle(s) {ids}")
+        if plan.own:
+            print(f"Bridge, sensors, road and solver: the log's own scenario ({scenario.title})")
+        else:
+            print(f"Bridge, sensors, road and solver: {other.source if other else ''} ({scenario.title})")
+        bridge = scenario.build_bridge()
+        _print(_header_lines(scenario, bridge, log_path))
+        status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
+                                           attachments=plan.attachments)
+    if outcome is None:
+        return status
+    print()
+    _print(_sensor_summary(scenario, outcome.result))
+    _print(_vehicle_summary(outcome))
+    _print(_run_lines(outcome))
+    print(_log_done_line(outcome))
+    comparison = runner.compare_sensors(log, log_path)
+    print()
+    if plan.own:
+        return _print_reproduction(comparison, log)
+    _print(_comparison_lines(comparison, log, log_path, scenario))
+    return 0
+
+
+def _print_reproduction(comparison: runner.Comparison, log: Path) -> int:
+    n = len(comparison.names)
+    part = ""
+    if comparison.samples_a != comparison.samples_b:  # e.g. the log was interrupted: compare what it holds
+        part = f"; the log holds {comparison.samples_a}, the replay {comparison.samples_b}"
+    if comparison.identical:
+        print(f"Compared with {log}: the {n} sensor channel(s) are identical, bit for bit "
+              f"({comparison.compared} samples{part})")
+        return 0
+    worst = ", ".join(f"{k} {v:.3g}" for k, v in comparison.max_abs_diff.items())
+    print(f"Compared with {log}: the sensor channels DIFFER (largest |difference|, SI units: {worst}; "
+          f"{comparison.compared} samples compared)")
+    return EXIT_RUN_FAILED
+
+
+def _comparison_lines(comparison: runner.Comparison, log: Path, new: Path, scenario: Scenario) -> list[str]:
+    quantities = {s.name: s.quantity for s in scenario.sensors}
+    if not comparison.names:
+        return [f"Compared with {log}: no sensor of the same name in both logs"]
+    width = max(len("name"), *(len(n) for n in comparison.names))
+    lines = [f"Sensors of the same name, the logged run vs this bridge ({new}):",
+             f"  {'name':<{width}}{'log min':>12}{'log max':>12}{'new min':>12}{'new max':>12}  unit"]
+    for name in comparison.names:
+        unit, factor = DISPLAY_UNITS.get(quantities.get(name, ""), ("SI", 1.0))
+        (a0, a1), (b0, b1) = comparison.extremes_a[name], comparison.extremes_b[name]
+        lines.append(f"  {name:<{width}}{a0 * factor:12.4g}{a1 * factor:12.4g}{b0 * factor:12.4g}"
+                     f"{b1 * factor:12.4g}  {unit}")
+    return lines
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    overview = runner.open_log(args.log)
+    rows, columns = runner.export_csv(args.log, args.csv, topic=args.topic, force=args.force)
+    if overview.truncated:
+        print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
+              file=sys.stderr)
+    units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
+    print(f"Wrote {rows} rows of {args.topic} to {args.csv} (columns {','.join(columns)}; {units})")
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    _print(_info_lines(runner.open_log(args.log)))
+    return 0
+
+
+def _info_lines(o: runner.LogOverview) -> list[str]:
+    info = o.info
+    lines = [f"Log: {o.path} ({_size(o.size)}, {'finished file' if o.complete else 'TRUNCATED'})"]
+    if info:
+        lines.append(f"Scenario: {info.get('scenario', '?')} (source: {info.get('source', '?')})")
+        lines.append(f"Written by: cosim {info.get('version', '?')} ({info.get('kind', 'run')}), "
+                     f"started {info.get('started', '?')}")
+        replay = o.metadata.get(runner.REPLAY_METADATA_NAME)
+        if replay:
+            lines.append(f"Replay of: {replay.get('log', '?')} (traffic of {replay.get('log_scenario', '?')}; "
+                         f"bridge of {replay.get('scenario', '?')})")
+        every = info.get("every", "?")
+        steps = "every step" if every == "1" else f"every {every} steps"
+        rate = _g(float(info["rate_hz"]), 4) if "rate_hz" in info else "?"
+        lines.append(f"Solver: {info.get('scheme', '?')}, {info.get('basis', '?')} basis, "
+                     f"dt = {info.get('dt', '?')} s; logged at {rate} Hz ({steps})")
+        planned = info.get("duration")
+        planned_text = f" of {_g(float(planned), 6)} s" if planned else ""
+        lines.append(f"Simulated: {_g(o.end_time, 6)} s{planned_text}")
+    else:
+        lines.append("Scenario: (no cosim metadata in this log)")
+        lines.append(f"Simulated: {_g(o.end_time, 6)} s")
+    sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
+    lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
+    if "vehicles" in info:
+        try:
+            vehicles = json.loads(info["vehicles"])
+            lines.append(f"Vehicles ({len(vehicles)}): {', '.join(vehicles) or 'none'}")
+        except ValueError:
+            pass
+    lines.append("Topics:")
+    width = max([len(t) for t in o.counts] + [10])
+    for topic, count in sorted(o.counts.items()):
+        lines.append(f"  {topic:<{width}}  {count:>9} messages")
+    status = o.final_status
+    if status is None:
+        lines.append("Status: none logged")
+    else:
+        message = f": {status['message']}" if status.get("message") else ""
+        lines.append(f"Status: {status.get('state', '?')} at t = {_g(float(status.get('t', 0.0)), 6)} s{message}")
+    if o.complete:
+        lines.append("Truncated: no")
+    else:
+        lines.append("Truncated: yes - the file was cut short (the process was killed?); "
+                     "it is read up to its last complete chunk")
+    atts = ", ".join(f"{name} ({_size(len(data))})" for name, data in o.attachments.items()) or "none"
+    lines.append(f"Attachments: {atts}")
+    return lines
+
+
+def _cmd_plot(args: argparse.Namespace) -> int:
+    drawn = runner.plot_sensors(args.log, args.output, args.sensor, force=args.force)
+    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)}) "
+          f"to {args.output}")
     return 0
 
 
@@ -572,9 +711,13 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run                              # the bundled default bridge ({DEFAULT_SCENARIO})
+              cosim run                              # the bundled default bridge ({DEFAULT_SCENARIO}) -> runs/*.mcap
+              cosim run my-bridge.toml --out run1.mcap
+              cosim info run1.mcap
+              cosim export run1.mcap --csv run1.csv
+              cosim plot run1.mcap -o run1.png
+              cosim replay run1.mcap --scenario other-bridge.toml
               cosim modes paper-double-tee --count 12 --plot modes.png
-              cosim modes my-bridge.toml --json
             """
         )
         + "\n"
@@ -622,31 +765,36 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = commands.add_parser(
         "run",
-        help="run a scenario: the time simulation of its vehicles (or, without any, modes and a static case)",
+        help="run a scenario into an MCAP log (or, without vehicles, modes and a static case)",
         description=textwrap.dedent(
             f"""\
             Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}' (the paper's
             two quarter-cars crossing its 40 m double-tee bridge).
 
-            With [[vehicles]]: integrate the coupled vehicle-bridge equations in time,
-            write every sensor's time history to a CSV file (columns t,<sensor names>,
-            SI units) and print a summary: sensor peaks, each vehicle's contact
-            force and whether it lifted off, steps, wall time, real-time factor and
-            factorisation count. A progress display goes to stderr.
+            With [[vehicles]]: integrate the coupled vehicle-bridge equations in time and
+            stream everything into an MCAP log: sensor samples, vehicles on the deck with
+            their contact forces, traffic events (entered/left the deck, lift-off) and the
+            run's status, with the scenario, its input files, resolved parameters, section
+            constants and frequencies embedded (a log alone is enough to run it again:
+            cosim replay). Then print a summary: sensor peaks, each vehicle's contact force
+            and whether it lifted off, steps, wall time, real-time factor. A progress
+            display goes to stderr. The log is finished whatever ends the run: Ctrl-C
+            leaves status "interrupted", a diverging solution status "error".
 
             Without [[vehicles]]: the modal analysis (first 10 modes) and a static load
             case, a {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once
             on the bridge axis (y = 0) and once at the left deck edge (largest y),
-            with each sensor's deck displacement for both.
+            with each sensor's deck displacement for both (no log).
 
-            Exit status: 0 done, 1 the solution diverged, 2 bad input, 130 interrupted
-            (Ctrl-C; no CSV is written then)."""
+            Exit status: 0 done, 1 the solution diverged (the log ends with status
+            "error"), 2 bad input (before any file is written), 130 interrupted (Ctrl-C;
+            the log ends with status "interrupted")."""
         ),
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run                              # the paper's case -> runs/{DEFAULT_SCENARIO}.csv
-              cosim run my-bridge.toml --out results/run1.csv --force
+              cosim run                              # the paper's case -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run my-bridge.toml --out results/run1.mcap --csv results/run1.csv
               cosim run my-bridge-no-vehicles.toml --out summary.json
             """
         )
@@ -657,14 +805,113 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenario", metavar="SCENARIO", nargs="?", default=DEFAULT_SCENARIO,
                      help=f"scenario file (.toml) or bundled scenario name (default: {DEFAULT_SCENARIO})")
     run.add_argument("--out", metavar="PATH",
-                     help="with vehicles: the sensor CSV (default: [output].csv, else runs/<scenario name>.csv; "
-                          "its folder is created); without vehicles: write the modes and static "
-                          "displacements as JSON to PATH")
+                     help="with vehicles: the MCAP log, LOG.mcap (default: [output].log, else "
+                          "runs/<scenario name>-<YYYYmmdd-HHMMSS>.mcap; its folder is created); without "
+                          "vehicles: write the modes and static displacements as JSON to PATH")
+    run.add_argument("--csv", metavar="OUT.csv",
+                     help="also write the sensor channels as CSV, columns t,<sensor names> (default: [output].csv "
+                          "if given); the same as 'cosim export LOG --csv OUT.csv' after the run")
     run.add_argument("--force", "-f", action="store_true",
-                     help="overwrite the sensor CSV if it exists (default: refuse)")
+                     help="overwrite the log and the CSV if they exist (default: refuse)")
     run.add_argument("--quiet", "-q", action="store_true",
                      help="no progress display on stderr")
     run.set_defaults(func=_cmd_run)
+
+    replay = commands.add_parser(
+        "replay",
+        help="re-drive a bridge with the traffic recorded in a log",
+        description=textwrap.dedent(
+            """\
+            Re-drive a bridge with the traffic of a log: the [[vehicles]] of the scenario
+            embedded in the log (parsed, never executed). Without --scenario, the log's own
+            scenario runs again: its sensor channels are compared with the log's and must
+            be identical, bit for bit (exit status 1 if they are not). With --scenario
+            OTHER, the bridge, sensors, road and solver come from OTHER and the vehicles
+            from the log: what would this traffic do to that bridge? The replay is logged
+            like a run; [output].log and [output].csv of the scenarios are not used.
+
+            Exit status: 0 done, 1 the solution diverged or (own scenario) the channels
+            differ, 2 bad input (unreadable log, a vehicle off OTHER's deck, ...),
+            130 interrupted."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim replay runs/paper-double-tee-20250101-120000.mcap
+              cosim replay runs/run1.mcap --scenario paper-double-tee-asymmetric --out runs/asym.mcap
+            """
+        ),
+        formatter_class=formatter,
+    )
+    replay.add_argument("log", metavar="LOG.mcap", help="a log written by cosim run (or replay)")
+    replay.add_argument("--scenario", metavar="OTHER",
+                        help="scenario file or bundled name whose bridge, sensors, road and solver to use")
+    replay.add_argument("--out", metavar="NEW.mcap",
+                        help="the replay's log (default: runs/<scenario name>-replay-<YYYYmmdd-HHMMSS>.mcap)")
+    replay.add_argument("--force", "-f", action="store_true", help="overwrite NEW.mcap if it exists")
+    replay.add_argument("--quiet", "-q", action="store_true", help="no progress display on stderr")
+    replay.set_defaults(func=_cmd_replay)
+
+    topics = ", ".join(runner.EXPORT_TOPICS)
+    export = commands.add_parser(
+        "export",
+        help="write a topic of a log as CSV (default: the sensor channels)",
+        description=textwrap.dedent(
+            f"""\
+            Write a topic of a log as CSV with a header row, SI units, numbers in their
+            shortest exact form. {TOPIC_SENSORS} (default): columns t,<sensor names>, one row
+            per sample. {TOPIC_VEHICLES}: one row per vehicle on the deck per sample (t, id,
+            model, x, y, speed, acceleration, body_displacement, body_acceleration,
+            contact_force). {TOPIC_EVENTS} and {TOPIC_STATUS}: one row per message.
+            A log cut short is exported up to its last complete chunk."""
+        ),
+        epilog="examples:\n  cosim export runs/run1.mcap --csv run1.csv\n"
+               f"  cosim export runs/run1.mcap --topic {TOPIC_VEHICLES} --csv vehicles.csv\n",
+        formatter_class=formatter,
+    )
+    export.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    export.add_argument("--csv", metavar="OUT.csv", required=True, help="the CSV file to write")
+    export.add_argument("--topic", default=TOPIC_SENSORS, metavar="TOPIC",
+                        help=f"the topic to export (one of: {topics}; default: {TOPIC_SENSORS})")
+    export.add_argument("--force", "-f", action="store_true", help="overwrite OUT.csv if it exists")
+    export.set_defaults(func=_cmd_export)
+
+    info = commands.add_parser(
+        "info",
+        help="summarise a log: scenario, duration, topics, status, truncated or not",
+        description=textwrap.dedent(
+            """\
+            Summarise a log: its scenario, cosim version, simulated time, sensors, topics
+            with message counts, final status and message, whether the file is truncated
+            (cut short by a killed process: exit status 0, the readable part is shown) and
+            its attachments. Every chunk's checksum is verified: a damaged file or one that
+            is not a cosim MCAP log exits with status 2."""
+        ),
+        epilog="example:\n  cosim info runs/run1.mcap\n",
+        formatter_class=formatter,
+    )
+    info.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    info.set_defaults(func=_cmd_info)
+
+    plot = commands.add_parser(
+        "plot",
+        help="draw the sensor time histories of a log",
+        description=textwrap.dedent(
+            """\
+            Draw the time histories of a log's sensors, one panel each, over time in s
+            (displacements in mm, velocities in mm/s, accelerations in m/s^2, bending
+            moments in kN m)."""
+        ),
+        epilog="examples:\n  cosim plot runs/run1.mcap -o run1.png\n"
+               "  cosim plot runs/run1.mcap --sensor node1 --sensor node3_acc -o two.png\n",
+        formatter_class=formatter,
+    )
+    plot.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    plot.add_argument("--sensor", action="append", metavar="NAME",
+                      help="a sensor to draw (repeat for more; default: all)")
+    plot.add_argument("-o", "--output", required=True, metavar="FIG.png", help="the figure (.png, .pdf, .svg, ...)")
+    plot.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
+    plot.set_defaults(func=_cmd_plot)
     return parser
 
 

@@ -14,12 +14,15 @@ file is truncated. Logs are parsed, never evaluated or unpickled.
 """
 from __future__ import annotations
 
+import bisect
 import io
+import itertools
 import json
 import os
 import queue
 import struct
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, Iterable, Iterator
@@ -168,43 +171,43 @@ class _BulkWriter(Writer):
                 self.add_message(channel_id, ns, data, ns, sequence)
             return sequence
         pack = _MESSAGE_HEAD.pack
+        sizes = [9 + _MESSAGE_FIXED + len(d) for d in datas]
+        ends = list(itertools.accumulate(sizes))  # record ends relative to the batch start
         start, n = 0, len(datas)
         while start < n:
             buffer = builder.record_writer._buffer  # a new one after every finished chunk
-            offset = buffer.tell()
-            room = limit - offset
-            parts: list[bytes] = []
-            index: list[tuple[int, int]] = []
-            stop = start
-            while stop < n:
-                data, ns = datas[stop], log_times[stop]
-                sequence += 1
-                parts.append(pack(_MESSAGE_OPCODE, _MESSAGE_FIXED + len(data), channel_id, sequence, ns, ns))
-                parts.append(data)
-                index.append((ns, offset))
-                offset += 9 + _MESSAGE_FIXED + len(data)
-                stop += 1
-                if offset - buffer.tell() > room:  # the chunk is full: finish it, as add_message would
-                    break
+            base = buffer.tell()
+            skipped = ends[start - 1] if start else 0
+            # Records up to and including the first one that takes the chunk past its size, as add_message does.
+            stop = min(bisect.bisect_right(ends, limit - base + skipped, lo=start) + 1, n)
+            count = stop - start
+            seqs = range(sequence + 1, sequence + count + 1)
+            times = log_times[start:stop]
+            parts: list[bytes] = [b""] * (2 * count)
+            parts[0::2] = [pack(_MESSAGE_OPCODE, size - 9, channel_id, seq, ns, ns)
+                           for size, seq, ns in zip(sizes[start:stop], seqs, times)]
+            parts[1::2] = datas[start:stop]
             buffer.write(b"".join(parts))
-            first, last = min(t for t, _ in index), max(t for t, _ in index)
+            offsets = [base + e - skipped - size for e, size in zip(ends[start:stop], sizes[start:stop])]
+            sequence += count
+            first, last = min(times), max(times)
             records = builder.message_indices.get(channel_id)
             if records is None:
                 records = builder.message_indices[channel_id] = _MessageIndex(channel_id=channel_id, records=[])
-            records.records.extend(index)
+            records.records.extend(zip(times, offsets))
             if builder.num_messages == 0:
                 builder.message_start_time = first
             else:
                 builder.message_start_time = min(builder.message_start_time, first)
             builder.message_end_time = max(builder.message_end_time, last)
-            builder.num_messages += len(index)
+            builder.num_messages += count
             if stats.message_count == 0:
                 stats.message_start_time = first
             else:
                 stats.message_start_time = min(stats.message_start_time, first)
             stats.message_end_time = max(stats.message_end_time, last)
-            stats.channel_message_counts[channel_id] += len(index)
-            stats.message_count += len(index)
+            stats.channel_message_counts[channel_id] += count
+            stats.message_count += count
             finalize()
             start = stop
         return sequence
@@ -447,6 +450,29 @@ def file_is_complete(path: str | Path) -> bool:
         return False
 
 
+#: The block logger's writer thread waits this long at most for the solver's next block, s.
+PACE_TIMEOUT = 0.02
+#: ... and then this long, for the solver thread to enter its compiled (GIL-free) loop, s.
+PACE_DELAY = 0.0003
+
+
+class _PacedTraffic:
+    """A traffic source that signals an event whenever the solver asks for its next block."""
+
+    def __init__(self, traffic: Any, pace: threading.Event | None) -> None:
+        self.traffic = traffic
+        self._pace = pace
+
+    def block(self, times):  # noqa: ANN001, ANN201 - the TrafficSource protocol
+        out = self.traffic.block(times)
+        if self._pace is not None:
+            self._pace.set()
+        return out
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.traffic, name)
+
+
 class BlockLogger:
     """Observer of :func:`cosim.simulation.simulate` that streams every block into a :class:`LogRecorder`.
 
@@ -474,6 +500,8 @@ class BlockLogger:
         self._sensor_template = (b'{"t":%s' + b"".join(b"," + _template_part(n) + b":%s" for n in self.names) + b"}")
         self._vehicle_templates: dict[tuple[str, ...], bytes] = {}
         self._error: BaseException | None = None
+        self._pace: threading.Event | None = None
+        self._closing = False
         self._queue: queue.Queue | None = None
         self._thread: threading.Thread | None = None
         if threaded:
@@ -489,12 +517,32 @@ class BlockLogger:
         else:
             self._queue.put((times, keep, report))
 
+    def paced(self, traffic: Any) -> "_PacedTraffic":
+        """``traffic``, wrapped so that the writer thread knows when the solver starts its next block.
+
+        Pass the wrapper to :func:`cosim.simulation.simulate` instead of
+        ``traffic``: the thread then encodes a block while the compiled solver
+        (which releases the GIL) computes the next one, instead of holding the
+        GIL while the solver thread needs it between two blocks. It costs
+        nothing in correctness: without a signal the thread waits at most
+        :data:`PACE_TIMEOUT`.
+        """
+        if self._queue is None:
+            return _PacedTraffic(traffic, None)
+        self._pace = threading.Event()
+        return _PacedTraffic(traffic, self._pace)
+
     def _drain(self) -> None:
         assert self._queue is not None
         while True:
             item = self._queue.get()
             if item is None:
                 return
+            pace = self._pace
+            if pace is not None and not self._closing:
+                pace.wait(PACE_TIMEOUT)
+                pace.clear()
+                time.sleep(PACE_DELAY)  # let the solver thread reach its compiled loop
             if self._error is None:
                 try:
                     self._write_block(*item)
@@ -505,6 +553,9 @@ class BlockLogger:
     def close(self) -> None:
         """Wait until every queued block is written."""
         if self._thread is not None and self._queue is not None:
+            self._closing = True
+            if self._pace is not None:
+                self._pace.set()
             self._queue.put(None)
             self._thread.join()
             self._thread = None
@@ -533,6 +584,7 @@ class BlockLogger:
             template = self._sensor_template
             rec.write_encoded(TOPIC_SENSORS, t.tolist(),
                               [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)])
+        self._gone(times, report)
         if report.ids:
             self._events(times, report)
             self._vehicles(times, kept, report)
@@ -540,6 +592,14 @@ class BlockLogger:
             rec.status(float(times[-1]), "running", progress=float(times[-1] / self.total_time))
             rec.flush()
             self._next_status += self.status_every
+
+    def _gone(self, times, report) -> None:
+        """Vehicles on the deck at the end of the last block that the traffic no longer has: they left."""
+        present = set(report.ids)
+        for vid in [v for v, on in self._on.items() if on and v not in present]:
+            t = float(times[0])
+            self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left"})
+            self._on[vid] = self._lifted[vid] = False
 
     def _events(self, times, report) -> None:
         """Entered/left the deck and lift-off/touch-down: transitions at any step of the block."""

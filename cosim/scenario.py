@@ -32,6 +32,7 @@ one (``model_copy(update=...)``).
 from __future__ import annotations
 
 import contextlib
+import datetime
 import difflib
 import json
 import math
@@ -134,6 +135,8 @@ DEFAULT_MODAL_MODES = 30
 #: Without ``solver.duration``, the run lasts until the last vehicle leaves the deck plus this, s.
 RING_DOWN = 2.0
 DEFAULT_OUTPUT_DIR = "runs"
+#: Default logging rate of ``[output]``, Hz (every step when dt is longer than its period).
+DEFAULT_RATE_HZ = 100.0
 
 
 # --------------------------------------------------------------------------- errors
@@ -948,10 +951,34 @@ class SolverConfig(_Model):
 
 
 class OutputConfig(_Model):
-    """``[output]``: where the sensor time histories go and how often they are sampled."""
+    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, and the logging rate.
 
+    The rate is ``rate_hz`` (default :data:`DEFAULT_RATE_HZ`) or, for
+    compatibility, ``every`` (keep every N-th step); not both.
+    """
+
+    log: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    rate_hz: Positive | None = None
+    every: PositiveInt | None = None
     csv: Annotated[str, Strict(), Field(min_length=1)] | None = None
-    every: PositiveInt = 1
+
+    @model_validator(mode="after")
+    def _one_rate(self) -> OutputConfig:
+        if self.rate_hz is not None and self.every is not None:
+            raise _fail(
+                f"give either rate_hz (logging rate, Hz) or every (keep every N-th step), not both "
+                f"(got rate_hz = {_show(self.rate_hz)} and every = {self.every})", "every"
+            )
+        if self.log is not None and not self.log.lower().endswith(".mcap"):
+            raise _fail(f"the log is an MCAP file: expected a path ending in .mcap (got {_show(self.log)})", "log")
+        return self
+
+    def decimation(self, dt: float) -> int:
+        """Steps per logged sample: ``every``, else ``round(1 / (rate_hz dt))`` (at least 1)."""
+        if self.every is not None:
+            return self.every
+        rate = self.rate_hz if self.rate_hz is not None else DEFAULT_RATE_HZ
+        return max(1, int(round(1.0 / (rate * dt))))
 
 
 def _leave_time(vehicle: ScriptedVehicle, length: float) -> float:
@@ -1085,6 +1112,16 @@ class Scenario(_Model):
         return self
 
     @model_validator(mode="after")
+    def _rate_within_steps(self) -> Scenario:
+        rate, dt = self.output.rate_hz, self.solver.dt
+        if rate is not None and rate * dt > 1.0 + 1e-9:
+            raise _fail(
+                f"must be <= 1 / solver.dt = {_num(1.0 / dt)} Hz (got {_show(rate)}): "
+                "the log samples the solver's steps, it cannot be faster than them", "output", "rate_hz"
+            )
+        return self
+
+    @model_validator(mode="after")
     def _road_file(self, info: ValidationInfo) -> Scenario:
         if self.road.profile is None:
             return self
@@ -1168,11 +1205,29 @@ class Scenario(_Model):
         return Path(self._base_dir) / self.road.profile
 
     @property
-    def csv_path(self) -> Path:
-        """Where the sensor CSV goes: ``output.csv``, default ``runs/<title>.csv`` (relative to the current folder)."""
-        if self.output.csv is not None:
-            return Path(self.output.csv)
-        return Path(DEFAULT_OUTPUT_DIR) / f"{_file_name(self.title)}.csv"
+    def csv_path(self) -> Path | None:
+        """The extra sensor CSV, ``output.csv`` (relative to the current folder), or None."""
+        return Path(self.output.csv) if self.output.csv is not None else None
+
+    @property
+    def log_path(self) -> Path | None:
+        """The MCAP log of a run, ``output.log`` (relative to the current folder), or None for the default."""
+        return Path(self.output.log) if self.output.log is not None else None
+
+    def default_log_path(self, started: datetime.datetime | None = None, suffix: str = "") -> Path:
+        """``runs/<title><suffix>-<YYYYmmdd-HHMMSS>.mcap`` (relative to the current folder)."""
+        stamp = (started or datetime.datetime.now()).strftime("%Y%m%d-%H%M%S")
+        return Path(DEFAULT_OUTPUT_DIR) / f"{_file_name(self.title)}{suffix}-{stamp}.mcap"
+
+    @property
+    def output_every(self) -> int:
+        """Solver steps per logged sample (``[output]`` rate_hz or every, with ``solver.dt``)."""
+        return self.output.decimation(self.solver.dt)
+
+    @property
+    def output_rate_hz(self) -> float:
+        """The logging rate actually used, Hz: ``1 / (output_every * dt)``."""
+        return 1.0 / (self.output_every * self.solver.dt)
 
     @property
     def leave_time(self) -> float | None:
@@ -1256,7 +1311,7 @@ class Scenario(_Model):
             bridge: the model from :meth:`build_bridge`, if already built.
 
         Returns:
-            The sensor and vehicle time histories, sampled every ``output.every`` steps.
+            The sensor and vehicle time histories, sampled every :attr:`output_every` steps.
 
         Raises:
             ConfigError: the scenario cannot be run as given (e.g. no duration).
@@ -1272,7 +1327,7 @@ class Scenario(_Model):
         try:
             return simulate(
                 bridge, traffic, duration, solver=solver, sensors=sensors, road=road,
-                output_every=self.output.every, progress=progress,
+                output_every=self.output_every, progress=progress,
             )
         except (ConfigError, ModelError) as exc:
             raise type(exc)(f"{self._source}: {exc}") from exc

@@ -47,11 +47,15 @@ def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProces
 @pytest.mark.parametrize(
     ("args", "mentions"),
     [
-        ((), ["modes", "run", "docs/scenario.md", "examples:"]),
+        ((), ["modes", "run", "replay", "export", "info", "plot", "docs/scenario.md", "examples:"]),
         (("modes",), ["SCENARIO", "--count", "--json", "--plot", "examples:"]),
-        (("run",), ["SCENARIO", "--out", "--force", "--quiet", "paper-double-tee", "examples:"]),
+        (("run",), ["SCENARIO", "--out", "LOG.mcap", "--csv", "--force", "--quiet", "paper-double-tee", "examples:"]),
+        (("replay",), ["LOG.mcap", "--scenario", "--out", "bit for bit", "examples:"]),
+        (("export",), ["LOG.mcap", "--csv", "--topic", "/cosim/vehicles", "examples:"]),
+        (("info",), ["LOG.mcap", "truncated", "example:"]),
+        (("plot",), ["LOG.mcap", "--sensor", "-o", "examples:"]),
     ],
-    ids=["cosim", "modes", "run"],
+    ids=["cosim", "modes", "run", "replay", "export", "info", "plot"],
 )
 def test_help_exits_zero_and_describes_options(args: tuple[str, ...], mentions: list[str]) -> None:
     result = cosim_cli(*args, "--help")
@@ -112,22 +116,27 @@ def test_unwritable_output_fails_before_the_work(tmp_path: Path) -> None:
     assert result.returncode == 2
     assert "does not exist" in result.stderr
     assert result.stdout == ""
-    # With vehicles, --out is the sensor CSV: its folder is created, unless a file is in the way.
+    # With vehicles, --out is the MCAP log: its folder is created, unless a file is in the way.
     (tmp_path / "a-file").write_text("", encoding="utf-8")
-    result = cosim_cli("run", "--out", str(tmp_path / "a-file" / "run.csv"))
+    result = cosim_cli("run", "--out", str(tmp_path / "a-file" / "run.mcap"))
     assert result.returncode == 2
     assert result.stderr.strip() == (
-        f"cosim: error: {tmp_path / 'a-file' / 'run.csv'}: cannot create the folder for the sensor CSV: "
+        f"cosim: error: {tmp_path / 'a-file' / 'run.mcap'}: cannot create the folder for the log: "
         f"{str(tmp_path / 'a-file')!r} is a file"
     )
     assert result.stdout == ""
 
 
-def test_mcap_output_is_not_implemented_yet(tmp_path: Path) -> None:
-    result = cosim_cli("run", "--out", str(tmp_path / "run.mcap"))
+def test_out_is_the_log_and_static_runs_have_none(tmp_path: Path) -> None:
+    result = cosim_cli("run", "--out", str(tmp_path / "run.csv"))
     assert result.returncode == 2
-    assert "MCAP logs are not implemented yet" in result.stderr
-    assert not (tmp_path / "run.mcap").exists()
+    assert "--out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv" in result.stderr
+    static = tmp_path / "static.toml"
+    static.write_text(PAPER_STATIC_TEXT, encoding="utf-8")
+    result = cosim_cli("run", str(static), "--out", str(tmp_path / "run.mcap"))
+    assert result.returncode == 2
+    assert "no [[vehicles]], so there is no time simulation to log" in result.stderr
+    assert not (tmp_path / "run.mcap").exists() and not (tmp_path / "run.csv").exists()
 
 
 # --------------------------------------------------------------------------- results
@@ -168,7 +177,7 @@ def test_run_without_vehicles_writes_the_static_summary(tmp_path: Path) -> None:
     result = cosim_cli("run", str(static), "--out", str(out), cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert "the scenario has no [[vehicles]]" in result.stdout
-    assert not (tmp_path / "runs").exists()  # no time simulation, no CSV
+    assert not (tmp_path / "runs").exists()  # no time simulation, no log
     summary = json.loads(out.read_text(encoding="utf-8"))
     assert summary["scenario"] == "paper-static"
     assert len(summary["modes"]) == 10

@@ -548,8 +548,26 @@ MALFORMED = [
     pytest.param(
         replaced("every = 1 ", 'mcap = "run.mcap"\nevery = 1 '),
         "output.mcap",
-        ["unknown key", "expected one of: csv, every"],
-        id="output-mcap-not-yet",
+        ["unknown key", "expected one of: log, rate_hz, every, csv"],
+        id="output-unknown-key",
+    ),
+    pytest.param(
+        replaced("every = 1 ", "rate_hz = 50.0\nevery = 1 "),
+        "output.every",
+        ["give either rate_hz", "or every", "not both"],
+        id="output-rate-and-every",
+    ),
+    pytest.param(
+        replaced("every = 1 ", "rate_hz = 400.0 "),
+        "output.rate_hz",
+        ["must be <= 1 / solver.dt = 200 Hz", "got 400.0"],
+        id="output-rate-above-steps",
+    ),
+    pytest.param(
+        replaced("every = 1 ", 'log = "run.csv" '),
+        "output.log",
+        ["expected a path ending in .mcap"],
+        id="output-log-not-mcap",
     ),
     pytest.param(
         replaced('start = [-6.655, 0.0]', 'start = [-6.655]'),
@@ -794,14 +812,27 @@ def test_bad_road_profile_file(tmp_path: Path, content: str, fragments: list[str
         assert fragment in first, (fragment, first)
 
 
-def test_output_defaults_and_csv_path(tmp_path: Path) -> None:
-    scenario = parse_scenario(CONSTANTS_TEXT)
-    assert (scenario.output.csv, scenario.output.every) == (None, 1)
-    assert scenario.csv_path == Path("runs") / "small.csv"
+def test_output_defaults_log_path_and_rate(tmp_path: Path) -> None:
+    import datetime
+
+    scenario = parse_scenario(CONSTANTS_TEXT)  # dt = 0.005 s by default
+    assert (scenario.output.log, scenario.output.csv, scenario.output.every, scenario.output.rate_hz) == (
+        None, None, None, None)
+    assert scenario.csv_path is None and scenario.log_path is None
+    assert (scenario.output_every, scenario.output_rate_hz) == (2, 100.0)  # the default 100 Hz
+    when = datetime.datetime(2025, 1, 2, 3, 4, 5)
+    assert scenario.default_log_path(when) == Path("runs") / "small-20250102-030405.mcap"
     unnamed = load_scenario(write(tmp_path, CONSTANTS_TEXT.replace('name = "small"', 'name = "my bridge/2"')))
-    assert unnamed.csv_path == Path("runs") / "my_bridge_2.csv"
-    given = parse_scenario(CONSTANTS_TEXT + '[output]\ncsv = "out/run1.csv"\nevery = 4\n')
-    assert (given.csv_path, given.output.every) == (Path("out/run1.csv"), 4)
+    assert unnamed.default_log_path(when, "-replay") == Path("runs") / "my_bridge_2-replay-20250102-030405.mcap"
+    given = parse_scenario(CONSTANTS_TEXT + '[output]\nlog = "out/run1.mcap"\ncsv = "out/run1.csv"\nevery = 4\n')
+    assert (given.log_path, given.csv_path, given.output_every) == (Path("out/run1.mcap"), Path("out/run1.csv"), 4)
+    # round(1 / (rate dt)) steps per sample; the rate actually used follows from it.
+    rated = parse_scenario(CONSTANTS_TEXT + "[solver]\ndt = 0.002\n[output]\nrate_hz = 30.0\n")
+    assert (rated.output_every, rated.output_rate_hz) == (17, pytest.approx(1 / 0.034))
+    coarse = parse_scenario(CONSTANTS_TEXT + "[solver]\ndt = 0.02\n")  # 100 Hz > 1/dt: every step
+    assert coarse.output_every == 1
+    exact = parse_scenario(CONSTANTS_TEXT + "[output]\nrate_hz = 200.0\n")  # = 1/dt: allowed
+    assert exact.output_every == 1
 
 
 def test_sensors_core_and_solver_settings() -> None:

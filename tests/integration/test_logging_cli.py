@@ -1,0 +1,423 @@
+"""MCAP logs through the command line, as users run it: real files, real subprocesses, real signals.
+
+``cosim run`` -> log -> ``info`` / ``export`` / ``plot``; ``replay`` bit for bit
+and onto another bridge; Ctrl-C (SIGINT) and SIGKILL in the middle of a run;
+damaged and foreign files; overwrite refusal; every message of a real run
+against its JSON Schema.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from importlib import resources
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+import tomllib
+
+import cosim
+from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
+from cosim.runner import toml_dumps
+from cosim.scenario import load_scenario
+
+REPO = Path(cosim.__file__).resolve().parents[1]
+
+# A 20 m span with explicit constants (fast to build): a quarter-car along +x
+# and a golden car along -x on a class H road (the light wheels lift off),
+# logged at 100 Hz (every 5th step of 2 ms).
+CARS = """\
+name = "cars"
+[bridge]
+spans = [20.0]
+elements_per_span = 8
+supports = ["pinned", "fork"]
+[bridge.material]
+E = 30e9
+nu = 0.2
+rho = 2500
+[bridge.section.constants]
+A = 2.0
+I_y = 0.5
+I_z = 8.0
+J = 0.2
+deck_y = [-3.0, 3.0]
+[bridge.damping]
+ratios = [0.02, 0.02]
+modes = ["vertical-1", "torsion-1"]
+[[sensors]]
+name = "mid"
+x = 10.0
+[[sensors]]
+name = "mid_left_acc"
+x = 10.0
+y = 2.0
+quantity = "acceleration"
+[[vehicles]]
+id = "truck"
+model = "quarter-car"
+m_v = 1000.0
+m_w = 100.0
+k_v = 4e4
+c_v = 5e3
+y = 1.5
+speed = 10.0
+[[vehicles]]
+id = "car"
+model = "golden-car"
+m_v = 300.0
+y = -1.5
+speed = 25.0
+entry_time = 0.5
+direction = "-x"
+[road]
+class = "H"
+seed = 7
+[solver]
+dt = 0.002
+"""
+
+# The same bridge with a measured road profile next to the scenario (an input
+# file the log must carry) and a different name.
+PROFILED = CARS.replace('name = "cars"', 'name = "profiled"').replace(
+    '[road]\nclass = "H"\nseed = 7', '[road]\nprofile = "data/road.csv"')
+
+# Another bridge for the same traffic: 24 m, stiffer, other damping.
+OTHER = (CARS.replace('name = "cars"', 'name = "other"').replace("spans = [20.0]", "spans = [24.0]")
+         .replace("I_y = 0.5", "I_y = 0.9").replace("ratios = [0.02, 0.02]", "ratios = [0.05, 0.05]"))
+
+# A run long enough to be stopped from outside: one slow car, 10 000 s, every step logged.
+LONG = (CARS.replace('name = "cars"', 'name = "long"').replace("speed = 25.0", "speed = 0.05")
+        .replace("[solver]\ndt = 0.002", "[solver]\ndt = 0.002\nduration = 10000.0\n[output]\nevery = 1"))
+
+
+def env() -> dict[str, str]:
+    environ = dict(os.environ)
+    environ["PYTHONPATH"] = os.pathsep.join([str(REPO), environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    environ["MPLBACKEND"] = "Agg"
+    return environ
+
+
+def cosim_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd,
+                          env=env(), timeout=300)
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def sensors_of(path: Path) -> list[dict]:
+    return read_log(path, [TOPIC_SENSORS]).topic(TOPIC_SENSORS)
+
+
+def one_line_error(result: subprocess.CompletedProcess[str], *fragments: str) -> None:
+    assert result.returncode == 2, (result.stdout, result.stderr)
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cosim: error: "), result.stderr
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+
+
+@pytest.fixture(scope="module")
+def cars_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """One real run of CARS, shared by the read-only tests."""
+    folder = tmp_path_factory.mktemp("cars")
+    scenario = write(folder, "cars.toml", CARS)
+    result = cosim_cli("run", str(scenario), "--out", "cars.mcap", "--quiet", cwd=folder)
+    assert result.returncode == 0, result.stderr
+    assert "Wrote the log cars.mcap (" in result.stdout
+    return folder / "cars.mcap"
+
+
+# --------------------------------------------------------------------------- run -> log
+
+
+def test_the_log_holds_the_run_exactly_and_is_self_contained(cars_log: Path) -> None:
+    log = read_log(cars_log)
+    assert not log.truncated and log.final_status["state"] == "finished"
+    # The sensor channels are the simulation's own samples, float for float (t = 0 at rest included).
+    expected = load_scenario(cars_log.parent / "cars.toml").simulate()
+    samples = log.topic(TOPIC_SENSORS)
+    np.testing.assert_array_equal([m["t"] for m in samples], expected.t)
+    for name, values in expected.sensors.items():
+        np.testing.assert_array_equal([m[name] for m in samples], values)
+    assert [ns for ns, _ in log.messages[TOPIC_SENSORS]][:3] == [0, 10_000_000, 20_000_000]  # integer ns
+    # What a re-run needs: the scenario text exactly, resolved parameters, section, modes, metadata.
+    assert log.attachments["scenario.toml"] == CARS.encode()
+    resolved = json.loads(log.attachments["resolved.json"])
+    assert resolved["scenario"]["solver"]["scheme"] == "newmark" and resolved["derived"]["output_every"] == 5
+    assert json.loads(log.attachments["section.json"])["A"] == 2.0
+    modes = json.loads(log.attachments["modes.json"])["modes"]
+    assert modes[0]["kind"] == "vertical" and len(modes) == 20
+    meta = log.metadata["cosim"]
+    assert (meta["version"], meta["scenario"], meta["dt"], meta["rate_hz"]) == (cosim.__version__, "cars", "0.002",
+                                                                                repr(100.0))
+    assert json.loads(meta["sensors"]) == ["mid", "mid_left_acc"]
+    states = [m["state"] for m in log.topic(TOPIC_STATUS)]
+    assert states[0] == "started" and states[-1] == "finished"
+    events = {(e["vehicle"], e["event"]) for e in log.topic(TOPIC_EVENTS)}
+    assert {("truck", "entered"), ("truck", "left"), ("car", "entered"), ("car", "left")} <= events
+    assert any(kind == "liftoff" for _, kind in events)  # class H road
+
+
+def test_every_message_validates_against_its_schema(cars_log: Path) -> None:
+    from mcap.reader import make_reader
+
+    counts: dict[str, int] = {}
+    with open(cars_log, "rb") as fh:
+        reader = make_reader(fh, validate_crcs=True)
+        for schema, channel, message in reader.iter_messages():
+            assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
+            jsonschema.validate(json.loads(message.data), json.loads(schema.data))
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+        summary = reader.get_summary()
+    assert counts[TOPIC_SENSORS] == 401 and counts[TOPIC_VEHICLES] > 100 and counts[TOPIC_EVENTS] >= 4
+    assert summary.statistics.message_count == sum(counts.values())
+    assert all(index.compression == "zstd" for index in summary.chunk_indexes)
+
+
+def test_info_export_and_plot(cars_log: Path, tmp_path: Path) -> None:
+    info = cosim_cli("info", str(cars_log), cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    out = info.stdout
+    for text in ("Scenario: cars", f"cosim {cosim.__version__}", "Simulated: 4 s of 4 s",
+                 "Sensors (2): mid (displacement), mid_left_acc (acceleration)", "Vehicles (2): truck, car",
+                 "/cosim/sensors", "401 messages", "Status: finished", "Truncated: no", "scenario.toml"):
+        assert text in out, (text, out)
+
+    table = tmp_path / "cars.csv"
+    result = cosim_cli("export", str(cars_log), "--csv", str(table), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    with open(table, newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["t", "mid", "mid_left_acc"] and len(rows) == 402
+    samples = sensors_of(cars_log)
+    assert [[float(v) for v in row] for row in rows[1:]] == [[m["t"], m["mid"], m["mid_left_acc"]] for m in samples]
+
+    vehicles = tmp_path / "vehicles.csv"
+    assert cosim_cli("export", str(cars_log), "--topic", TOPIC_VEHICLES, "--csv", str(vehicles),
+                     cwd=tmp_path).returncode == 0
+    with open(vehicles, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert {r["id"] for r in rows} == {"truck", "car"} and {r["model"] for r in rows} == {"quarter-car",
+                                                                                          "tyre-quarter-car"}
+    assert float(rows[0]["contact_force"]) > 0
+
+    figure = tmp_path / "cars.png"
+    result = cosim_cli("plot", str(cars_log), "--sensor", "mid", "-o", str(figure), cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    one_line_error(cosim_cli("plot", str(cars_log), "--sensor", "nope", "-o", str(tmp_path / "x.png"), cwd=tmp_path),
+                   "no sensor nope in this log (sensors: mid, mid_left_acc)")
+
+
+def test_outputs_are_never_overwritten_silently(cars_log: Path, tmp_path: Path) -> None:
+    keep = write(tmp_path, "keep.csv", "mine\n")
+    figure = write(tmp_path, "keep.png", "mine\n")
+    for args in (("export", str(cars_log), "--csv", str(keep)), ("plot", str(cars_log), "-o", str(figure)),
+                 ("replay", str(cars_log), "--out", str(cars_log))):
+        one_line_error(cosim_cli(*args, cwd=tmp_path), "already exists")
+    assert keep.read_text() == "mine\n" and figure.read_text() == "mine\n"
+    assert cosim_cli("export", str(cars_log), "--csv", str(keep), "--force", cwd=tmp_path).returncode == 0
+    assert keep.read_text().startswith("t,mid,mid_left_acc")
+
+
+# --------------------------------------------------------------------------- replay
+
+
+def test_replay_reproduces_the_sensors_bit_for_bit_from_the_log_alone(tmp_path: Path) -> None:
+    run_dir = tmp_path / "run"
+    scenario = write(run_dir, "profiled.toml", PROFILED)
+    x = np.linspace(-1.0, 21.0, 221).tolist()
+    write(run_dir, "data/road.csv", "x,r\n" + "".join(f"{a!r},{0.004 * np.sin(1.3 * a):.6f}\n" for a in x))
+    result = cosim_cli("run", str(scenario), "--out", "first.mcap", "--quiet", cwd=run_dir)
+    assert result.returncode == 0, result.stderr
+    first = run_dir / "first.mcap"
+    assert read_log(first).attachments["data/road.csv"].startswith(b"x,r\n")
+    moved = tmp_path / "elsewhere"
+    moved.mkdir()
+    os.replace(first, moved / "first.mcap")
+    (run_dir / "data" / "road.csv").unlink()  # the log alone must be enough
+    scenario.unlink()
+
+    result = cosim_cli("replay", "first.mcap", "--out", "again.mcap", "--quiet", cwd=moved)
+    assert result.returncode == 0, result.stderr
+    assert "the 2 sensor channel(s) are identical, bit for bit (401 samples)" in result.stdout
+    a, b = sensors_of(moved / "first.mcap"), sensors_of(moved / "again.mcap")
+    assert a == b and len(a) == 401
+    again = read_log(moved / "again.mcap")
+    assert again.attachments["scenario.toml"] == PROFILED.encode()
+    assert again.metadata["replay"]["log"] == "first.mcap" and again.metadata["cosim"]["kind"] == "replay"
+
+
+def test_replay_onto_another_bridge(cars_log: Path, tmp_path: Path) -> None:
+    other = write(tmp_path, "other.toml", OTHER)
+    result = cosim_cli("replay", str(cars_log), "--scenario", str(other), "--out", "other.mcap", "--quiet",
+                       cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "Sensors of the same name, the logged run vs this bridge" in result.stdout
+    new = read_log(tmp_path / "other.mcap")
+    assert new.final_status["state"] == "finished"
+    merged = tomllib.loads(new.attachments["scenario.toml"].decode())
+    assert merged["bridge"]["spans"] == [24.0] and [v["id"] for v in merged["vehicles"]] == ["truck", "car"]
+    assert new.attachments["replay/bridge-scenario.toml"] == OTHER.encode()
+    # Same traffic, another bridge: a longer crossing, other deflections.
+    old_mid = np.array([m["mid"] for m in sensors_of(cars_log)])
+    new_mid = np.array([m["mid"] for m in new.topic(TOPIC_SENSORS)])
+    assert len(new_mid) > len(old_mid) and abs(new_mid.min() - old_mid.min()) > 0.05 * abs(old_mid.min())
+    # The replay's log replays by itself, bit for bit.
+    again = cosim_cli("replay", "other.mcap", "--out", "other-again.mcap", "--quiet", cwd=tmp_path)
+    assert again.returncode == 0 and "identical, bit for bit" in again.stdout, again.stderr
+
+    bridge_only = OTHER[:OTHER.index("[[vehicles]]")] + "[solver]\ndt = 0.002\nduration = 1.0\n"
+    narrow = write(tmp_path, "narrow.toml", bridge_only.replace("deck_y = [-3.0, 3.0]", "deck_y = [-1.0, 1.0]")
+                   .replace("y = 2.0", "y = 0.5"))
+    result = cosim_cli("replay", str(cars_log), "--scenario", str(narrow), cwd=tmp_path)
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert result.stderr.startswith(f"cosim: error: {narrow} with the traffic of {cars_log}: vehicles[0].y: "
+                                    "must lie on the deck, -1 <= y <= 1 m (got 1.5)"), result.stderr
+
+
+# --------------------------------------------------------------------------- stopped runs
+
+
+def start_long_run(folder: Path) -> tuple[subprocess.Popen[str], Path]:
+    scenario = write(folder, "long.toml", LONG)
+    log = folder / "long.mcap"
+
+    def default_sigint() -> None:  # a child of a non-interactive shell may inherit SIGINT ignored
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+    proc = subprocess.Popen([sys.executable, "-m", "cosim", "run", str(scenario), "--out", str(log)],
+                            cwd=folder, env=env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_sigint)
+    deadline = time.monotonic() + 60
+    while not (log.exists() and log.stat().st_size > 600_000):  # a few chunks are on disk
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the run did not write its log"
+        time.sleep(0.05)
+    return proc, log
+
+
+def test_ctrl_c_leaves_a_finished_log_with_status_interrupted(tmp_path: Path) -> None:
+    proc, log = start_long_run(tmp_path)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, (out, err)
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1].endswith(f'the log up to there is in {log} (finished, status "interrupted")')
+    contents = read_log(log)
+    assert not contents.truncated and contents.final_status["state"] == "interrupted"
+    assert 0 < len(contents.topic(TOPIC_SENSORS)) < 5_000_000
+    info = cosim_cli("info", str(log), cwd=tmp_path)
+    assert info.returncode == 0 and "Status: interrupted" in info.stdout and "Truncated: no" in info.stdout
+
+
+def test_sigkill_leaves_a_truncated_log_that_can_still_be_read(tmp_path: Path) -> None:
+    proc, log = start_long_run(tmp_path)
+    proc.kill()
+    proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGKILL
+    info = cosim_cli("info", str(log), cwd=tmp_path)
+    assert info.returncode == 0, info.stderr
+    assert "TRUNCATED" in info.stdout and "Truncated: yes" in info.stdout and "Scenario: long" in info.stdout
+    result = cosim_cli("export", str(log), "--csv", "part.csv", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert "was cut short (truncated)" in result.stderr
+    with open(tmp_path / "part.csv", newline="") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0] == ["t", "mid", "mid_left_acc"] and len(rows) > 1000
+    times = [float(r[0]) for r in rows[1:]]
+    assert times == sorted(times) and times[0] == 0.0
+
+
+# --------------------------------------------------------------------------- bad files
+
+
+def test_foreign_damaged_and_missing_files_exit_2_with_one_line(cars_log: Path, tmp_path: Path) -> None:
+    text = write(tmp_path, "notes.mcap", "not a log at all\n")
+    raw = bytearray(cars_log.read_bytes())
+    from mcap.reader import make_reader
+
+    with open(cars_log, "rb") as fh:
+        chunk = make_reader(fh).get_summary().chunk_indexes[0]
+    middle = chunk.chunk_start_offset + chunk.chunk_length // 2
+    raw[middle:middle + 64] = bytes(64)  # inside the first chunk's compressed data
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(raw))
+    from mcap.writer import Writer
+
+    foreign = tmp_path / "foreign.mcap"
+    with open(foreign, "wb") as fh:
+        writer = Writer(fh)
+        writer.start(profile="ros2", library="test")
+        writer.finish()
+    cases = [(text, "not an MCAP file"), (damaged, "corrupt MCAP file"),
+             (foreign, "an MCAP file, but not a cosim log (profile 'ros2')"),
+             (tmp_path / "missing.mcap", "cannot read")]
+    for path, fragment in cases:
+        for args in (("info", str(path)), ("export", str(path), "--csv", str(tmp_path / "o.csv")),
+                     ("plot", str(path), "-o", str(tmp_path / "o.png")), ("replay", str(path))):
+            one_line_error(cosim_cli(*args, cwd=tmp_path), str(path), fragment)
+    assert not (tmp_path / "o.csv").exists() and not (tmp_path / "runs").exists()
+
+
+# --------------------------------------------------------------------------- pieces
+
+
+def test_scenarios_survive_the_toml_writer() -> None:
+    for text in (CARS, PROFILED, LONG, load_scenario("paper-double-tee").text):
+        data = tomllib.loads(text)
+        assert tomllib.loads(toml_dumps(data)) == data
+    odd = {"a b": "quote \" and \\ and \x7f", "x": [1, 2.5e-300, -0.0], "t": {"inner": [{"k": True}, {"k": False}]}}
+    assert tomllib.loads(toml_dumps(odd)) == odd
+
+
+def test_the_foxglove_layout_ships_with_the_package() -> None:
+    layout = json.loads(resources.files("cosim").joinpath("foxglove_layout.json").read_text(encoding="utf-8"))
+    text = json.dumps(layout)
+    assert TOPIC_SENSORS in text and TOPIC_VEHICLES in text and "configById" in layout
+
+
+def test_the_bulk_message_path_writes_the_same_bytes_as_mcap() -> None:
+    import io
+    import random
+
+    from mcap.writer import CompressionType
+
+    from cosim.log import _BulkWriter
+
+    rng = random.Random(1)
+    datas = [bytes(rng.randrange(256) for _ in range(rng.randrange(1, 2000))) for _ in range(1200)]
+    times = sorted(rng.randrange(10**12) for _ in datas)
+    for chunk_size in (1000, 16 * 1024, 1024 * 1024):
+        files = []
+        for bulk in (False, True):
+            out = io.BytesIO()
+            writer = _BulkWriter(out, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+            writer.start(profile="cosim", library="test")
+            schema = writer.register_schema("s", "jsonschema", b"{}")
+            channels = [writer.register_channel(topic, "json", schema) for topic in ("/a", "/b")]
+            sequence = 0
+            for k in range(0, len(datas), 100):
+                for channel in channels:
+                    if bulk:
+                        sequence = writer.add_encoded(channel, times[k:k + 100], datas[k:k + 100], sequence)
+                    else:
+                        for t, data in zip(times[k:k + 100], datas[k:k + 100]):
+                            sequence += 1
+                            writer.add_message(channel, t, data, t, sequence)
+            writer.finish()
+            files.append(out.getvalue())
+        assert files[0] == files[1], chunk_size
