@@ -37,7 +37,7 @@ from .log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
 from .scenario import Scenario, list_bundled_scenarios, load_scenario
 from .section import SectionProperties
 
-DEFAULT_SCENARIO = "paper-double-tee"
+DEFAULT_SCENARIO = "paper-bridge-traffic"
 STATIC_LOAD_N = 100e3
 NO_VEHICLES = (
     "the scenario has no [[vehicles]]; "
@@ -256,7 +256,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
             f"{args.out}: --out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv {args.out}"
         )
     scenario = load_scenario(args.scenario)
-    if scenario.vehicles:
+    if scenario.vehicles or scenario.traffic is not None:
         return _run_vehicles(scenario, args)
     return _run_static(scenario, args)
 
@@ -360,7 +360,19 @@ def _g(value: float, digits: int = 6) -> str:
 _PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m"}
 
 
+def _traffic_line(scenario: Scenario) -> str:
+    t = scenario.traffic
+    assert t is not None
+    level = f" (bundled {t.sumo_config} demand)" if t.bundled else ""
+    seed = f", seed {t.seed}" if t.seed is not None else ", the config's seed"
+    axis = t.axis or ((0.0, 0.0), (scenario.bridge.length, 0.0))
+    return (f"Traffic: SUMO {scenario.sumo_config_path}{level}, step {_g(t.step)} s, SUMO time {_g(t.begin)} to "
+            f"{_g(t.end)} s{seed}; bridge axis {axis[0]} -> {axis[1]} in network coordinates")
+
+
 def _vehicle_lines(scenario: Scenario) -> list[str]:
+    if scenario.traffic is not None:
+        return [_traffic_line(scenario)]
     rows = []
     for v in scenario.vehicles:
         if v.profile is not None:
@@ -397,6 +409,10 @@ def _solver_line(scenario: Scenario, duration: float) -> str:
             basis += f" (modes below {_g(solver.cutoff_hz or 0.0)} Hz)"
     if solver.duration is not None:
         how = "given"
+    elif scenario.traffic is not None:
+        how = "[traffic] end - begin"
+    elif not scenario.vehicles:
+        how = "the replayed log's"
     else:
         how = f"last vehicle leaves the deck at {_g(scenario.leave_time or 0.0, 4)} s, + 2 s"
     steps = int(round(duration / solver.dt))
@@ -428,16 +444,23 @@ def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - 
     return lines
 
 
-def _vehicle_summary(outcome: runner.RunOutcome) -> list[str]:
+def _vehicle_summary(outcome: runner.RunOutcome, limit: int = 12) -> list[str]:
     result = outcome.result
-    ids = [v.id for v in outcome.scenario.vehicles]
-    width = max(len("id"), *(len(i) for i in ids))
+    scripted = [v.id for v in outcome.scenario.vehicles]
+    ids = scripted or sorted(outcome.on_deck, key=lambda v: -result.contact_force_range.get(v, (0, 0))[1])
+    lifted_total = sum(1 for v in outcome.on_deck if result.contact_force_range.get(v, (0.0, 0.0))[0] < 0)
+    of = f" of {len(scripted)}" if scripted else ""
     lines = [
-        f"Vehicles: {len(outcome.on_deck)} of {len(ids)} on the deck during the run, at most {result.max_on_deck} "
-        "at once; contact force, compression positive",
-        f"  {'id':<{width}}  {'on the deck [s]':<18}{'min [kN]':>10}{'max [kN]':>10}  lifted off",
+        f"Vehicles: {len(outcome.on_deck)}{of} on the deck during the run, at most {result.max_on_deck} "
+        f"at once, {lifted_total} lifted off; contact force, compression positive"
+        + ("" if scripted or len(ids) <= limit else f" (the {limit} heaviest shown)"),
     ]
-    for vid in ids:
+    if not ids:
+        return lines
+    shown = ids if scripted else ids[:limit]
+    width = max(len("id"), *(len(i) for i in shown))
+    lines.append(f"  {'id':<{width}}  {'on the deck [s]':<18}{'min [kN]':>10}{'max [kN]':>10}  lifted off")
+    for vid in shown:
         if vid not in outcome.on_deck:
             lines.append(f"  {vid:<{width}}  not on the deck during the run")
             continue
@@ -479,14 +502,15 @@ def _log_done_line(outcome: runner.RunOutcome) -> str:
             f"at {_g(outcome.rate_hz, 4)} Hz from t = 0; status finished)")
 
 
-def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path) -> list[str]:
+def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path, duration: float | None = None) -> list[str]:
     spans = " + ".join(f"{span:g}" for span in bridge.spans)
+    replayed = not scenario.vehicles and scenario.traffic is None
     return [
         f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
         *_damping_lines(bridge),
-        *_vehicle_lines(scenario),
+        *(["Traffic: the replayed log's SUMO frames"] if replayed else _vehicle_lines(scenario)),
         _road_line(scenario),
-        _solver_line(scenario, scenario.duration),
+        _solver_line(scenario, duration if duration is not None else scenario.duration),
         _logging_line(scenario, log_path),
     ]
 
@@ -494,7 +518,7 @@ def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path) -> li
 def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, args: argparse.Namespace,
                      **extra: Any) -> tuple[int, runner.RunOutcome | None]:
     """The time simulation into ``log_path``: (exit status, outcome) with the failure messages printed."""
-    duration = scenario.duration
+    duration = extra.get("duration") or scenario.duration
     sys.stdout.flush()
     progress = _Progress(duration, show=not args.quiet)
     try:
@@ -548,18 +572,22 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         log_path = _log_target(args.out, default, args.force)
         if log_path.resolve() == log.resolve():
             raise CosimError(f"{log_path}: the replay cannot overwrite the log it replays")
-        ids = ", ".join(v.id for v in scenario.vehicles)
         status_word = runner.status_word(plan.overview)
-        print(f"Replay of {log} ({plan.record['log_scenario']}, {status_word}): "
-              f"its {len(scenario.vehicles)} scripted vehicle(s) {ids}")
+        if plan.traffic is not None:
+            what = f"its SUMO traffic ({plan.record.get('traffic', 'logged frames')}; SUMO is not run again)"
+        else:
+            ids = ", ".join(v.id for v in scenario.vehicles)
+            what = f"its {len(scenario.vehicles)} scripted vehicle(s) {ids}"
+        print(f"Replay of {log} ({plan.record['log_scenario']}, {status_word}): {what}")
         if plan.own:
             print(f"Bridge, sensors, road and solver: the log's own scenario ({scenario.title})")
         else:
             print(f"Bridge, sensors, road and solver: {other.source if other else ''} ({scenario.title})")
         bridge = scenario.build_bridge()
-        _print(_header_lines(scenario, bridge, log_path))
+        _print(_header_lines(scenario, bridge, log_path, plan.duration))
         status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
-                                           attachments=plan.attachments)
+                                           attachments=plan.attachments, traffic=plan.traffic,
+                                           duration=plan.duration)
     if outcome is None:
         return status
     print()
@@ -768,10 +796,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="run a scenario into an MCAP log (or, without vehicles, modes and a static case)",
         description=textwrap.dedent(
             f"""\
-            Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}' (the paper's
-            two quarter-cars crossing its 40 m double-tee bridge).
+            Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}': the paper's
+            40 m double-tee bridge under 10 minutes of medium two-way SUMO traffic on an
+            ISO 8608 class A road.
 
-            With [[vehicles]]: integrate the coupled vehicle-bridge equations in time and
+            With [[vehicles]] (scripted) or [traffic] (SUMO): integrate the coupled vehicle-bridge equations in time and
             stream everything into an MCAP log: sensor samples, vehicles on the deck with
             their contact forces, traffic events (entered/left the deck, lift-off) and the
             run's status, with the scenario, its input files, resolved parameters, section
@@ -793,7 +822,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run                              # the paper's case -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run                              # the default traffic run -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run paper-double-tee             # the paper's two quarter-cars
               cosim run my-bridge.toml --out results/run1.mcap --csv results/run1.csv
               cosim run my-bridge-no-vehicles.toml --out summary.json
             """

@@ -17,6 +17,7 @@ nothing here prints.
 """
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime
 import io
@@ -42,7 +43,7 @@ else:  # pragma: no cover - Python 3.10
 
 from . import __version__
 from .bridge import BridgeModel, ModalResult
-from .errors import ConfigError, CosimError, LogError, ModelError
+from .errors import ConfigError, CosimError, LogError, ModelError, SumoError
 from .log import (
     EVENTS_SCHEMA,
     PROFILE,
@@ -51,10 +52,14 @@ from .log import (
     TOPIC_SENSORS,
     TOPIC_STATUS,
     TOPIC_TRAFFIC,
+    TOPIC_VEHICLE_TYPES,
     TOPIC_VEHICLES,
     VEHICLE_ITEM,
     BlockLogger,
     LogRecorder,
+    TrafficLogger,
+    read_log,
+    traffic_from_log,
 )
 from .scenario import Scenario, parse_scenario
 from .section import SectionProperties
@@ -78,7 +83,6 @@ DISPLAY_UNITS: dict[str, tuple[str, float]] = {
 SI_UNITS = {"displacement": "m", "velocity": "m/s", "acceleration": "m/s^2", "bending_moment": "N m"}
 #: Scenario keys that name input files (dotted key -> attachment folder for unsafe paths).
 INPUT_KEYS = ("road.profile",)
-SUMO_REPLAY_UNSUPPORTED = "this log's traffic came from SUMO; replay of SUMO logs is not supported yet"
 
 # --------------------------------------------------------------------------- payloads
 
@@ -273,7 +277,33 @@ def input_files(scenario: Scenario) -> list[InputFile]:
         safe = not pure.is_absolute() and ".." not in pure.parts and not re.match(r"^[A-Za-z]:", written)
         name = str(pure) if safe else f"inputs/{pure.name}"
         found.append(InputFile("road.profile", written, profile, name))
+    sumo_cfg = scenario.sumo_config_path
+    if sumo_cfg is not None:
+        for path in sumo_input_files(sumo_cfg):
+            rel = path.relative_to(sumo_cfg.parent) if path.is_relative_to(sumo_cfg.parent) else Path(path.name)
+            # Only the config is a scenario key; the files it names travel along as plain attachments.
+            key = "traffic.sumo_config" if path == sumo_cfg else ""
+            found.append(InputFile(key, str(path), path, f"sumo/{rel.as_posix()}"))
     return found
+
+
+def sumo_input_files(config: Path) -> list[Path]:
+    """The SUMO config and the net, route and additional files it names (parsed as XML, never run)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(config).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise ConfigError(f"{config}: not a readable SUMO config ({exc})") from None
+    files = [config]
+    for tag in ("net-file", "route-files", "additional-files"):
+        for element in root.iter(tag):
+            for name in element.get("value", "").split(","):
+                if name.strip():
+                    path = (config.parent / name.strip())
+                    if path.is_file() and path not in files:
+                        files.append(path)
+    return files
 
 
 @dataclass
@@ -368,6 +398,8 @@ def run_logged(
     replay: dict[str, str] | None = None,
     attachments: dict[str, bytes] | None = None,
     started: datetime.datetime | None = None,
+    traffic: Any = None,
+    duration: float | None = None,
 ) -> RunOutcome:
     """Run ``scenario``'s vehicles over its bridge and stream everything into the MCAP log ``log_path``.
 
@@ -386,22 +418,27 @@ def run_logged(
         replay: for a replay, what was replayed (stored as the "replay" metadata record).
         attachments: more documents to store (name -> bytes).
         started: wall-clock start time for the metadata (default now).
+        traffic: a traffic source to use instead of the scenario's (replay of logged SUMO frames).
+        duration: simulated time instead of the scenario's, s.
 
     Raises:
         KeyboardInterrupt: Ctrl-C; the log is finished first, with status "interrupted".
         RunFailed: the solution diverged; the log is finished first, with status "error".
         ConfigError, ModelError, LogError: bad input, before the log is created.
     """
-    if not scenario.vehicles:
-        raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]]: nothing to simulate in time")
+    if not scenario.vehicles and scenario.traffic is None and traffic is None:
+        raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
+                          "nothing to simulate in time")
     started = started or datetime.datetime.now().astimezone()
     if bridge is None:
         bridge = scenario.build_bridge()
-    traffic = scenario.build_vehicles()
+    live_sumo = traffic is None and scenario.traffic is not None
+    if traffic is None and not live_sumo:
+        traffic = scenario.build_vehicles()
     road = scenario.build_road()
     solver = scenario.solver_settings()
     sensors = scenario.sensors_core()
-    duration = scenario.duration
+    duration = duration if duration is not None else scenario.duration
     every = scenario.output_every
     rate_hz = scenario.output_rate_hz
     names = [s.name for s in sensors]
@@ -429,7 +466,9 @@ def run_logged(
         "sensors": json.dumps(names),
         "quantities": json.dumps([s.quantity for s in sensors]),
         "vehicles": json.dumps([v.id for v in scenario.vehicles]),
-        "inputs": json.dumps({item.key: item.attachment for item in inputs}),
+        "traffic": "sumo" if (live_sumo or scenario.traffic is not None) else (
+            "replayed frames" if traffic is not None and not scenario.vehicles else "scripted"),
+        "inputs": json.dumps({item.key: item.attachment for item in inputs if item.key}),
         "python": platform.python_version(),
     }
     resolved = {
@@ -457,7 +496,10 @@ def run_logged(
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
         try:
-            with BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
+            with contextlib.ExitStack() as stack, \
+                    BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
+                if live_sumo:  # SUMO starts inside the log: a SUMO failure is the log's final status
+                    traffic = stack.enter_context(scenario.build_traffic(frame_sink=TrafficLogger(rec)))
                 result = simulate(bridge, logger.paced(traffic), duration, solver=solver, sensors=sensors, road=road,
                                   output_every=every, progress=progress, observers=[extremes, samples, logger],
                                   collect=False)
@@ -474,6 +516,8 @@ def run_logged(
                 pass  # the log itself failed (e.g. disk full): report the first error
             if isinstance(exc, ModelError):
                 raise RunFailed(f"{scenario.source}: {exc}", log_path) from exc
+            if isinstance(exc, SumoError) and getattr(traffic, "sumo_steps", 0) > 0:
+                raise RunFailed(f"{scenario.source}: {exc}", log_path) from exc  # SUMO failed mid-run
             raise
         wall = time.perf_counter() - wall_start
         rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
@@ -838,8 +882,6 @@ def _extract(overview: LogOverview, folder: Path) -> dict[str, str]:
 
 
 def _scenario_text(overview: LogOverview) -> str:
-    if overview.counts.get(TOPIC_TRAFFIC):
-        raise LogError(f"{overview.path}: {SUMO_REPLAY_UNSUPPORTED}")
     raw = overview.attachments.get(SCENARIO_ATTACHMENT)
     if raw is None:
         raise LogError(f"{overview.path}: the log has no embedded {SCENARIO_ATTACHMENT} (not written by cosim run?)")
@@ -858,6 +900,8 @@ class ReplayPlan:
     own: bool
     record: dict[str, str]
     attachments: dict[str, bytes] = field(default_factory=dict)
+    traffic: Any = None  # the logged SUMO frames, for a log whose traffic came from SUMO
+    duration: float | None = None
 
 
 def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario | None = None) -> ReplayPlan:
@@ -865,10 +909,12 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
 
     Without ``other``: the log's own scenario (parsed from its embedded text,
     never executed). With ``other``: ``other``'s bridge, sensors, road, solver
-    and output with the log's ``[[vehicles]]``.
+    and output with the log's traffic: its ``[[vehicles]]``, or, for SUMO
+    traffic, the logged SUMO frames (positions along the original bridge's
+    axis; SUMO itself is not run again).
 
     Raises:
-        LogError: the log is unreadable, has no scenario, or its traffic came from SUMO.
+        LogError: the log is unreadable or has no scenario.
         ConfigError: the log's traffic does not fit ``other``'s bridge (e.g. a wheel path off its deck).
     """
     overview = open_log(log)
@@ -880,6 +926,7 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
         raise LogError(f"{source}: TOML syntax error: {exc}") from None
     record = {"log": str(overview.path), "log_scenario": overview.info.get("scenario", ""),
               "log_started": overview.info.get("started", ""), "log_status": status_word(overview)}
+    sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "traffic" in logged
     if other is None:
         inputs = _extract(overview, folder)
         data = tomllib.loads(text)
@@ -890,22 +937,41 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
                 changed = True
         scenario = parse_scenario(toml_dumps(data) if changed else text, source, base_dir=folder)
         record["scenario"] = "the log's own"
-        return ReplayPlan(scenario, overview, True, record)
-    if not logged.get("vehicles"):
-        raise LogError(f"{overview.path}: the log's scenario has no [[vehicles]]: no traffic to replay")
-    data = tomllib.loads(other.text)
-    data["vehicles"] = logged["vehicles"]
-    for item in input_files(other):
-        target = folder.joinpath(*PurePosixPath(item.attachment).parts)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(item.path.read_bytes())
-        _set_key(data, item.key, item.attachment)
-    merged = toml_dumps(data)
-    scenario = parse_scenario(merged, f"{other.source} with the traffic of {overview.path}", base_dir=folder)
-    record["scenario"] = other.source
-    attachments = {"replay/bridge-scenario.toml": other.text.encode(),
-                   "replay/traffic-scenario.toml": text.encode()}
-    return ReplayPlan(scenario, overview, False, record, attachments)
+        plan = ReplayPlan(scenario, overview, True, record)
+    else:
+        if not sumo and not logged.get("vehicles"):
+            raise LogError(f"{overview.path}: the log's scenario has no [[vehicles]] and no [traffic]: "
+                           "no traffic to replay")
+        data = tomllib.loads(other.text)
+        data.pop("traffic", None)
+        data.pop("vehicles", None)
+        if not sumo:
+            data["vehicles"] = logged["vehicles"]
+        for item in input_files(other):
+            if not item.key or item.key.startswith("traffic."):
+                continue
+            target = folder.joinpath(*PurePosixPath(item.attachment).parts)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(item.path.read_bytes())
+            _set_key(data, item.key, item.attachment)
+        merged = toml_dumps(data)
+        scenario = parse_scenario(merged, f"{other.source} with the traffic of {overview.path}", base_dir=folder)
+        record["scenario"] = other.source
+        attachments = {"replay/bridge-scenario.toml": other.text.encode(),
+                       "replay/traffic-scenario.toml": text.encode()}
+        plan = ReplayPlan(scenario, overview, False, record, attachments)
+    if not sumo:
+        return plan
+    try:
+        duration = float(overview.info["duration"])
+        step = float(logged["traffic"].get("step", 0.05))
+    except (KeyError, ValueError, TypeError, AttributeError):
+        raise LogError(f"{overview.path}: malformed cosim metadata (duration or traffic step)") from None
+    contents = read_log(overview.path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
+    traffic = traffic_from_log(contents, plan.scenario.bridge.length, step)
+    duration = min(duration, traffic.last_time)  # a cut-off log: as far as its frames go
+    record["traffic"] = f"{len(contents.messages.get(TOPIC_TRAFFIC, []))} logged SUMO frames"
+    return ReplayPlan(plan.scenario, overview, plan.own, record, plan.attachments, traffic, duration)
 
 
 def status_word(overview: LogOverview) -> str:

@@ -123,9 +123,12 @@ ROAD_CLASSES: tuple[str, ...] = (*ISO_CLASSES, "smooth")
 ROAD_MARGIN = 10.0
 
 #: Top-level sections that later versions add; rejected for now with a clear note.
-FUTURE_SECTIONS: dict[str, str] = {
-    "traffic": "SUMO traffic; use [[vehicles]] for scripted vehicles",
-}
+FUTURE_SECTIONS: dict[str, str] = {}
+
+#: ``[traffic].sumo_config`` may name one of these bundled demand levels (sumo_networks/<level>.sumocfg).
+SUMO_LEVELS: tuple[str, ...] = ("light", "medium", "heavy", "congested")
+#: With SUMO traffic, random road profiles are laid on wheel paths this far apart across the deck, m.
+SUMO_PATH_SPACING = 0.5
 
 _MODE_REF = re.compile(r"(?P<kind>[a-z]+)-(?P<n>[0-9]+)")
 _NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
@@ -392,6 +395,8 @@ def _pair(value: Any, names: str) -> tuple[float, float]:
 Point = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "y, z"))]
 """A section point (y, z) in metres."""
 Interval = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "min, max"))]
+NetPoint = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "x, y"))]
+"""A point (x, y) in SUMO network coordinates, m."""
 
 
 def _choice(choices: tuple[str, ...], what: str):  # noqa: ANN202 - returns a validator
@@ -898,6 +903,30 @@ class RoadConfig(_Model):
         return not self.random and self.profile is None
 
 
+class TrafficConfig(_Model):
+    """``[traffic]``: vehicles from a SUMO simulation (instead of scripted ``[[vehicles]]``)."""
+
+    sumo_config: Annotated[str, Strict(), Field(min_length=1)]
+    step: Positive = 0.05
+    begin: NonNegative = 0.0
+    end: Positive = 600.0
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
+    axis: tuple[NetPoint, NetPoint] | None = None
+    edges: tuple[Annotated[str, Strict(), Field(min_length=1)], ...] = ()
+
+    @model_validator(mode="after")
+    def _times(self) -> TrafficConfig:
+        if self.end <= self.begin:
+            raise _fail(f"must be after begin = {_show(self.begin)} s (got {_show(self.end)})", "end")
+        if self.axis is not None and math.dist(*self.axis) <= 0:
+            raise _fail("the two axis points must differ", "axis")
+        return self
+
+    @property
+    def bundled(self) -> bool:
+        return self.sumo_config in SUMO_LEVELS
+
+
 class SolverConfig(_Model):
     """``[solver]``: time integration settings."""
 
@@ -1020,6 +1049,7 @@ class Scenario(_Model):
     bridge: BridgeConfig
     sensors: tuple[SensorConfig, ...] = ()
     vehicles: tuple[VehicleConfig, ...] = ()
+    traffic: TrafficConfig | None = None
     road: RoadConfig = RoadConfig()
     solver: SolverConfig = SolverConfig()
     output: OutputConfig = OutputConfig()
@@ -1109,6 +1139,29 @@ class Scenario(_Model):
                     break
         if problems:
             raise _Problems(problems)
+        return self
+
+    @model_validator(mode="after")
+    def _traffic_fits(self, info: ValidationInfo) -> Scenario:
+        traffic = self.traffic
+        if traffic is None:
+            return self
+        if self.vehicles:
+            raise _fail("give either [traffic] (SUMO) or [[vehicles]] (scripted), not both", "traffic")
+        ratio = traffic.step / self.solver.dt
+        if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
+            raise _fail(f"SUMO's step must be a whole number of solver steps: step / solver.dt = "
+                        f"{_num(traffic.step)} / {_num(self.solver.dt)} = {ratio:.6g}", "traffic", "step")
+        length = self.bridge.length
+        if traffic.axis is not None and abs(math.dist(*traffic.axis) - length) > 1e-3:
+            raise _fail(f"the axis is {math.dist(*traffic.axis):.6g} m long; it must be the bridge's length, "
+                        f"{length:g} m", "traffic", "axis")
+        if not traffic.bundled:
+            base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
+            path = Path(base) / traffic.sumo_config
+            if not path.is_file():
+                raise _fail(f"file not found: {path} (a bundled level: {', '.join(SUMO_LEVELS)}; a relative path "
+                            "is relative to the scenario file's folder)", "traffic", "sumo_config")
         return self
 
     @model_validator(mode="after")
@@ -1246,6 +1299,8 @@ class Scenario(_Model):
         """
         if self.solver.duration is not None:
             return self.solver.duration
+        if self.traffic is not None:
+            return self.traffic.end - self.traffic.begin
         leave = self.leave_time
         if leave is None:
             raise ConfigError(
@@ -1260,8 +1315,49 @@ class Scenario(_Model):
             return ScriptedTraffic(tuple(v.to_scripted() for v in self.vehicles), self.bridge.length)
 
     def wheel_paths(self) -> tuple[float, ...]:
-        """The distinct lateral offsets of the vehicles, sorted, m (``(0.0,)`` without vehicles)."""
+        """Lateral offsets with a road profile of their own, sorted, m.
+
+        Scripted vehicles: their distinct offsets. SUMO traffic: paths every
+        0.5 m across the deck (a wheel uses the nearest), since lanes and
+        lateral positions come from SUMO. Otherwise ``(0.0,)``.
+        """
+        if self.traffic is not None:
+            y_min, y_max = self.bridge.section.deck_y
+            n = int(math.floor((y_max - y_min) / SUMO_PATH_SPACING)) + 1
+            return tuple(float(v) for v in y_min + SUMO_PATH_SPACING * np.arange(n))
         return tuple(sorted({v.y for v in self.vehicles})) or (0.0,)
+
+    @property
+    def sumo_config_path(self) -> Path | None:
+        """The SUMO config of ``[traffic]`` (a bundled level or a file relative to the scenario), or None."""
+        if self.traffic is None:
+            return None
+        if self.traffic.bundled:
+            from .sumo import bundled_networks
+
+            return bundled_networks() / f"{self.traffic.sumo_config}.sumocfg"
+        return Path(self._base_dir) / self.traffic.sumo_config
+
+    def build_traffic(self, frame_sink: Callable[..., None] | None = None) -> Any:
+        """The traffic source: :class:`cosim.sumo.SumoTraffic` (not started) for ``[traffic]``, else the
+        scripted vehicles (:meth:`build_vehicles`).
+
+        Args:
+            frame_sink: with SUMO, called with every frame (e.g. to log it).
+        """
+        if self.traffic is None:
+            return self.build_vehicles()
+        from .sumo import BridgeAxis, SumoTraffic  # only SUMO runs load libsumo
+
+        t = self.traffic
+        length = self.bridge.length
+        axis = BridgeAxis(*t.axis) if t.axis is not None else BridgeAxis((0.0, 0.0), (length, 0.0))
+        y_min, y_max = self.bridge.section.deck_y
+        path = self.sumo_config_path
+        assert path is not None
+        with self._named("traffic"):
+            return SumoTraffic(path, axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
+                               seed=t.seed, half_width=max(abs(y_min), abs(y_max)), frame_sink=frame_sink)
 
     def build_road(self) -> RoadProfile:
         """The road profile, one wheel path per distinct vehicle offset (:meth:`wheel_paths`).
@@ -1319,16 +1415,19 @@ class Scenario(_Model):
         """
         if bridge is None:
             bridge = self.build_bridge()
-        traffic = self.build_vehicles()
+        traffic = self.build_traffic()
         road = self.build_road()
         duration = self.duration
         solver = self.solver_settings()
         sensors = self.sensors_core()
         try:
-            return simulate(
-                bridge, traffic, duration, solver=solver, sensors=sensors, road=road,
-                output_every=self.output_every, progress=progress,
-            )
+            with contextlib.ExitStack() as stack:
+                if hasattr(traffic, "start"):  # SUMO: one simulation, closed whatever happens
+                    stack.enter_context(traffic)
+                return simulate(
+                    bridge, traffic, duration, solver=solver, sensors=sensors, road=road,
+                    output_every=self.output_every, progress=progress,
+                )
         except (ConfigError, ModelError) as exc:
             raise type(exc)(f"{self._source}: {exc}") from exc
 

@@ -142,8 +142,27 @@ def test_two_vehicles_end_to_end(tmp_path: Path) -> None:
     assert f"Wrote {ROWS} rows to run.csv" in out
 
 
-def test_default_run_is_the_papers_two_quarter_cars(tmp_path: Path) -> None:
+def test_default_run_is_ten_minutes_of_sumo_traffic(tmp_path: Path) -> None:
     result = cosim_cli("run", "--quiet", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    out = result.stdout
+    assert "Scenario: paper-bridge-traffic" in out and "Traffic: SUMO" in out and "medium demand" in out
+    assert "Road: ISO 8608 class A, seed 1" in out
+    on_deck = int(out.split("Vehicles: ")[1].split(" on the deck")[0])
+    assert on_deck > 100  # 10 min at 500 vehicles per hour and direction
+    log = only_log(tmp_path / "runs")
+    info = cosim_cli("info", str(log), cwd=tmp_path).stdout
+    assert "/cosim/traffic" in info and "Truncated: no" in info
+    # Both directions load the deck: the right edge (eastbound lane) and the left edge both go down.
+    assert cosim_cli("export", str(log), "--csv", "default.csv", cwd=tmp_path).returncode == 0
+    header, rows = read_csv(tmp_path / "default.csv")
+    low = {name: min(row[i] for row in rows) for i, name in enumerate(header) if i}
+    assert low["node2"] < -5e-3 and low["edge_right"] < -5e-3
+    assert rows[-1][0] == pytest.approx(600.0)
+
+
+def test_the_papers_two_quarter_cars(tmp_path: Path) -> None:
+    result = cosim_cli("run", "paper-double-tee", "--quiet", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""  # --quiet: no progress display
     assert "QC-1  quarter-car" in result.stdout and "QC-2  quarter-car" in result.stdout

@@ -155,3 +155,87 @@ def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, t
     assert len(logged) == len(replayed.t) - 1 and np.max(np.abs(replayed.sensors["mid"])) > 1e-4
     for name in names:
         np.testing.assert_array_equal(np.array([m[name] for m in logged]), replayed.sensors[name][1:])
+
+
+# ------------------------------------------------------------------ command line
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+
+from cosim.scenario import SUMO_LEVELS  # noqa: E402
+
+SCENARIO = """
+name = "sumo-cli"
+[bridge]
+spans = [40.0]
+elements_per_span = 10
+supports = ["rigid-end", "rigid-end"]
+[bridge.material]
+E = 33.0e9
+G = 13.75e9
+rho = 2500.0
+[bridge.section.constants]
+A = 4.8
+I_y = 1.6
+I_z = 65.0
+J = 0.15
+I_w = 19.0
+z_s = 0.59
+A_sy = 2.5
+A_sz = 0.9
+deck_y = [-6.655, 6.655]
+[bridge.damping]
+ratios = [0.02, 0.02]
+modes = ["vertical-1", "torsion-1"]
+[[sensors]]
+name = "mid"
+x = 20.0
+[[sensors]]
+name = "left"
+x = 20.0
+y = 6.0
+quantity = "acceleration"
+[traffic]
+sumo_config = "{config}"
+end = {end}
+seed = 3
+[road]
+class = "B"
+seed = 2
+"""
+
+
+def cosim(*args, cwd):
+    return subprocess.run([sys.executable, "-m", "cosim", *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+
+
+def test_cli_runs_sumo_traffic_and_replays_it_bit_for_bit(tmp_path):
+    assert "heavy" in SUMO_LEVELS
+    (tmp_path / "s.toml").write_text(SCENARIO.format(config="heavy", end=60.0))
+    run = cosim("run", "s.toml", "--out", "a.mcap", "--quiet", cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert "Traffic: SUMO" in run.stdout
+    replay = cosim("replay", "a.mcap", "--out", "b.mcap", "--quiet", cwd=tmp_path)
+    assert replay.returncode == 0, replay.stderr
+    assert "identical, bit for bit" in replay.stdout and "SUMO is not run again" in replay.stdout
+    other = cosim("replay", "a.mcap", "--scenario", "paper-double-tee-asymmetric", "--out", "c.mcap", "--quiet",
+                  cwd=tmp_path)
+    assert other.returncode == 0, other.stderr
+    info = cosim("info", "a.mcap", cwd=tmp_path).stdout
+    assert "sumo/heavy.sumocfg" in info and "sumo/bridge.net.xml" in info  # the inputs travel with the log
+
+
+def test_cli_reports_a_broken_sumo_config_and_finishes_the_log(tmp_path):
+    (tmp_path / "broken.sumocfg").write_text("<configuration><input><net-file value='missing.net.xml'/>"
+                                             "</input></configuration>")
+    (tmp_path / "s.toml").write_text(SCENARIO.format(config="broken.sumocfg", end=30.0))
+    run = cosim("run", "s.toml", "--out", "a.mcap", "--quiet", cwd=tmp_path)
+    assert run.returncode == 2
+    assert "Traceback" not in run.stderr and "SUMO could not load it" in run.stderr
+    log = read_log_status(tmp_path / "a.mcap")
+    assert log["state"] == "error" and "SUMO could not load it" in log["message"]
+
+
+def read_log_status(path):
+    from cosim.log import read_log
+
+    return read_log(path).final_status

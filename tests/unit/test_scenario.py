@@ -338,10 +338,35 @@ MALFORMED = [
         id="missing-required-key",
     ),
     pytest.param(
-        PAPER_TEXT + '\n[traffic]\nsumocfg = "net.sumocfg"\n',
+        PAPER_TEXT.split("[[vehicles]]")[0] + '\n[traffic]\nsumocfg = "net.sumocfg"\n',
+        "traffic.sumocfg",
+        ['did you mean "sumo_config"'],
+        id="traffic-misspelled-key",
+    ),
+    pytest.param(
+        PAPER_TEXT + '\n[traffic]\nsumo_config = "medium"\n',
         "traffic",
-        ["not supported yet", "expected one of: name, description, bridge, sensors, vehicles, road, solver, output"],
-        id="future-section-traffic",
+        ["either [traffic] (SUMO) or [[vehicles]] (scripted), not both"],
+        id="traffic-and-vehicles",
+    ),
+    pytest.param(
+        PAPER_TEXT.split("[[vehicles]]")[0] + '\n[traffic]\nsumo_config = "nowhere.sumocfg"\n',
+        "traffic.sumo_config",
+        ["file not found", "light, medium, heavy, congested"],
+        id="traffic-config-missing",
+    ),
+    pytest.param(
+        PAPER_TEXT.split("[[vehicles]]")[0].replace("duration = 20.0", "")
+        + '\n[traffic]\nsumo_config = "medium"\nstep = 0.0123\n',
+        "traffic.step",
+        ["whole number of solver steps"],
+        id="traffic-step-not-multiple-of-dt",
+    ),
+    pytest.param(
+        PAPER_TEXT.split("[[vehicles]]")[0] + '\n[traffic]\nsumo_config = "medium"\naxis = [[0, 0], [30, 0]]\n',
+        "traffic.axis",
+        ["must be the bridge's length, 40 m"],
+        id="traffic-axis-length",
     ),
     pytest.param(
         replaced('scheme = "newmark"', 'scheme = "generalized-alpha"'),
