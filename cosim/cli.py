@@ -366,7 +366,8 @@ def _traffic_line(scenario: Scenario) -> str:
     level = f" (bundled {t.sumo_config} demand)" if t.bundled else ""
     seed = f", seed {t.seed}" if t.seed is not None else ", the config's seed"
     axis = t.axis or ((0.0, 0.0), (scenario.bridge.length, 0.0))
-    return (f"Traffic: SUMO {scenario.sumo_config_path}{level}, step {_g(t.step)} s, SUMO time {_g(t.begin)} to "
+    where = f"sumo_networks/{t.sumo_config}.sumocfg" if t.bundled else str(scenario.sumo_config_path)
+    return (f"Traffic: SUMO {where}{level}, step {_g(t.step)} s, SUMO time {_g(t.begin)} to "
             f"{_g(t.end)} s{seed}; bridge axis {axis[0]} -> {axis[1]} in network coordinates")
 
 
@@ -389,10 +390,13 @@ def _vehicle_lines(scenario: Scenario) -> list[str]:
 
 def _road_line(scenario: Scenario) -> str:
     road = scenario.road
-    paths = ", ".join(f"{y:g}" for y in scenario.wheel_paths())
+    wheel = scenario.wheel_paths()
+    paths = "y = " + ", ".join(f"{y:g}" for y in wheel) + " m"
+    if scenario.traffic is not None or len(wheel) > 6:
+        paths = f"{len(wheel)} paths, y = {wheel[0]:g} to {wheel[-1]:g} m, each wheel on the nearest"
     if road.random:
         return (f"Road: ISO 8608 class {road.road_class}, seed {road.seed}, one profile per wheel path "
-                f"(y = {paths} m), x = -10 m to L + 10 m")
+                f"({paths}), x = -10 m to L + 10 m")
     if road.profile is not None:
         return f"Road: profile {scenario.road_profile_path} (x, r), on every wheel path"
     return "Road: smooth"
