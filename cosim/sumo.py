@@ -13,6 +13,7 @@ through with SUMO's ballistic motion between frames.
 """
 from __future__ import annotations
 
+import functools
 import math
 import os
 from dataclasses import dataclass
@@ -73,13 +74,17 @@ class BridgeAxis:
     def length(self) -> float:
         return math.dist(self.start, self.end)
 
+    @functools.cached_property
+    def _frame(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.unit()
+
     def unit(self) -> tuple[np.ndarray, np.ndarray]:
         e = (np.asarray(self.end, dtype=float) - np.asarray(self.start, dtype=float)) / self.length
         return e, np.array([-e[1], e[0]])  # along, left normal
 
     def project(self, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Bridge coordinates (x along the axis from start, y to the left) of network points."""
-        e, n = self.unit()
+        e, n = self._frame
         dx, dy = px - self.start[0], py - self.start[1]
         return dx * e[0] + dy * e[1], dx * n[0] + dy * n[1]
 
@@ -297,36 +302,30 @@ class SumoTraffic:
                 pass
         self._watched = present
         results = ls.vehicle.getAllSubscriptionResults()
-        ids, px, py, ang, spd, acc, length, types = [], [], [], [], [], [], [], []
-        for vid in sorted(present):
-            var = results.get(vid)
-            if var is None:
-                continue
-            pos = var[tc.VAR_POSITION]
-            ids.append(vid)
-            px.append(pos[0])
-            py.append(pos[1])
-            ang.append(var[tc.VAR_ANGLE])
-            spd.append(var[tc.VAR_SPEED])
-            acc.append(var[tc.VAR_ACCELERATION])
-            length.append(var[tc.VAR_LENGTH])
-            types.append(var[tc.VAR_TYPE])
-        for typ in set(types):
-            self._model(typ)
-        heading = np.radians(np.array(ang, dtype=float))
+        ids = [vid for vid in sorted(present) if vid in results]
+        n = len(ids)
+        rows = [results[vid] for vid in ids]
+        pos = np.array([r[tc.VAR_POSITION] for r in rows], dtype=float).reshape(n, 2)
+        ang = np.fromiter((r[tc.VAR_ANGLE] for r in rows), dtype=float, count=n)
+        spd = np.fromiter((r[tc.VAR_SPEED] for r in rows), dtype=float, count=n)
+        acc = np.fromiter((r[tc.VAR_ACCELERATION] for r in rows), dtype=float, count=n)
+        half = 0.5 * np.fromiter((r[tc.VAR_LENGTH] for r in rows), dtype=float, count=n)
+        types = [r[tc.VAR_TYPE] for r in rows]
+        for typ in types:
+            if typ not in self.models:
+                self._model(typ)
+        heading = np.radians(ang)
         hx, hy = np.sin(heading), np.cos(heading)  # SUMO angle: 0 = north, clockwise
-        half = 0.5 * np.array(length, dtype=float)
-        cx, cy = np.array(px, dtype=float) - half * hx, np.array(py, dtype=float) - half * hy
-        x, y = self.axis.project(cx, cy)
-        e, _ = self.axis.unit()
+        x, y = self.axis.project(pos[:, 0] - half * hx, pos[:, 1] - half * hy)
+        e, _ = self.axis._frame
         along = hx * e[0] + hy * e[1]
         keep = np.abs(y) <= self.half_width
         t = self.sumo_steps * self.step
-        return Frame(
-            t=t, ids=tuple(i for i, k in zip(ids, keep) if k), x=x[keep], y=y[keep],
-            v=(np.array(spd, dtype=float) * along)[keep], a=(np.array(acc, dtype=float) * along)[keep],
-            types=tuple(ty for ty, k in zip(types, keep) if k),
-        )
+        if not keep.all():
+            ids = [i for i, k in zip(ids, keep) if k]
+            types = [ty for ty, k in zip(types, keep) if k]
+            x, y, spd, acc, along = x[keep], y[keep], spd[keep], acc[keep], along[keep]
+        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=spd * along, a=acc * along, types=tuple(types))
 
     def block(self, times: np.ndarray) -> TrafficBlock:
         """Run SUMO as far as ``times`` (s from ``begin``) need and interpolate the vehicles there."""

@@ -263,42 +263,55 @@ class FrameTraffic:
         # Interval k covers (t_k, t_{k+1}]; a time on a frame belongs to the interval ending there.
         k_of = np.ceil(times / self.step - 1e-9).astype(np.int64) - 1
         k_of = np.maximum(k_of, self._first)
-        intervals = np.unique(k_of)
-        ids: list[str] = []
+        k_lo, k_hi = int(k_of.min()), int(k_of.max())
+        frames = [self._frame_at(k) for k in range(k_lo, k_hi + 2)]  # frames k_lo .. k_hi + 1
+        # One column per vehicle seen in any frame of the block; rows = frames.
         index: dict[str, int] = {}
-        pieces = []
-        for k in intervals:
-            f0, f1 = self._frame_at(int(k)), self._frame_at(int(k) + 1)
-            rows = np.flatnonzero(k_of == k)
-            prev = {vid: i for i, vid in enumerate(f0.ids)}
-            j0 = np.array([prev.get(vid, -1) for vid in f1.ids], dtype=np.int64)
-            seen = j0 >= 0
-            v1, a1, x1 = f1.v, f1.a, f1.x
-            v0 = np.where(seen, f0.v[np.maximum(j0, 0)] if len(f0.ids) else 0.0, v1 - a1 * self.step)
-            x0_traced = x1 - self.step * 0.5 * (v0 + v1)
-            x0 = np.where(seen, f0.x[np.maximum(j0, 0)] if len(f0.ids) else 0.0, x0_traced)
-            acc = (v1 - v0) / self.step
-            gap = x1 - (x0 + self.step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
-            tau = times[rows][:, None] - f0.t
-            x = x0 + v0 * tau + 0.5 * acc * tau**2 + gap * tau / self.step
-            v = v0 + acc * tau + gap / self.step
-            near = ((x >= -1e-9) & (x <= self.length + 1e-9)).any(axis=0)
-            for j in np.flatnonzero(near):
-                vid = f1.ids[j]
+        for f in frames:
+            for vid in f.ids:
                 if vid not in index:
-                    index[vid] = len(ids)
-                    ids.append(vid)
-            pieces.append((rows, f1, x, v, acc, near))
-        q = len(ids)
-        X = np.full((len(times), q), -1e6)  # absent: far before the deck
-        V = np.zeros((len(times), q))
-        A = np.zeros((len(times), q))
-        Y = np.zeros(q)
-        types: list[str] = [""] * q
-        for rows, f1, x, v, acc, near in pieces:
-            for j in np.flatnonzero(near):
-                c = index[f1.ids[j]]
-                X[rows, c], V[rows, c], A[rows, c] = x[:, j], v[:, j], acc[j]
-                Y[c] = f1.y[j]
-                types[c] = f1.types[j]
-        return TrafficBlock(tuple(ids), tuple(self.models[t] for t in types), X, V, A, Y)
+                    index[vid] = len(index)
+        q_all = len(index)
+        n_f = len(frames)
+        FX = np.zeros((n_f, q_all))
+        FV = np.zeros((n_f, q_all))
+        FA = np.zeros((n_f, q_all))
+        FY = np.zeros((n_f, q_all))
+        seen = np.zeros((n_f, q_all), dtype=bool)
+        type_of: dict[int, str] = {}
+        for r, f in enumerate(frames):
+            if not f.ids:
+                continue
+            cols = np.fromiter((index[v] for v in f.ids), dtype=np.int64, count=len(f.ids))
+            FX[r, cols], FV[r, cols], FA[r, cols], FY[r, cols] = f.x, f.v, f.a, f.y
+            seen[r, cols] = True
+            for c, typ in zip(cols.tolist(), f.types):
+                type_of[c] = typ
+        # Motion over each interval (row r: from frame r to frame r + 1), for vehicles in frame r + 1.
+        step = self.step
+        v1, a1, x1 = FV[1:], FA[1:], FX[1:]
+        had = seen[:-1]
+        v0 = np.where(had, FV[:-1], v1 - a1 * step)
+        x0 = np.where(had, FX[:-1], x1 - step * 0.5 * (v0 + v1))
+        acc = (v1 - v0) / step
+        gap = x1 - (x0 + step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
+        r_of = k_of - k_lo
+        tau = (times - np.array([frames[r].t for r in range(n_f)])[r_of])[:, None]
+        X = x0[r_of] + v0[r_of] * tau + 0.5 * acc[r_of] * tau**2 + gap[r_of] * tau / step
+        V = v0[r_of] + acc[r_of] * tau + gap[r_of] / step
+        A = acc[r_of]
+        present = seen[1:][r_of]
+        on = present & (X >= -1e-9) & (X <= self.length + 1e-9)
+        keep = np.flatnonzero(on.any(axis=0))
+        ids = list(index)
+        X = np.where(present, X, -1e6)[:, keep]  # absent: far before the deck
+        V = np.where(present, V, 0.0)[:, keep]
+        A = np.where(present, A, 0.0)[:, keep]
+        # One lateral offset per block: where the vehicle was at its last frame in the block.
+        rows = present[:, keep]
+        last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
+        Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
+        return TrafficBlock(
+            tuple(ids[c] for c in keep), tuple(self.models[type_of[c]] for c in keep),
+            np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y,
+        )
