@@ -26,19 +26,8 @@ def _without_vehicles(text: str) -> str:
 PAPER_STATIC_TEXT = _without_vehicles(PAPER_TEXT)
 
 
-def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m cosim ARGS`` against this checkout."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    env["MPLBACKEND"] = "Agg"
-    return subprocess.run(
-        [sys.executable, "-m", "cosim", *args],
-        capture_output=True,
-        text=True,
-        cwd=cwd or REPO,
-        env=env,
-        timeout=300,
-    )
+from _cli import cosim_cli  # noqa: E402
+
 
 
 # --------------------------------------------------------------------------- help

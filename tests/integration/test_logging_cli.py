@@ -27,61 +27,12 @@ from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES,
 from cosim.runner import toml_dumps
 from cosim.scenario import load_scenario
 
-REPO = Path(cosim.__file__).resolve().parents[1]
+from _cli import REPO, TWO_CARS, cli_env, cosim_cli
 
 # A 20 m span with explicit constants (fast to build): a quarter-car along +x
 # and a golden car along -x on a class H road (the light wheels lift off),
 # logged at 100 Hz (every 5th step of 2 ms).
-CARS = """\
-name = "cars"
-[bridge]
-spans = [20.0]
-elements_per_span = 8
-supports = ["pinned", "fork"]
-[bridge.material]
-E = 30e9
-nu = 0.2
-rho = 2500
-[bridge.section.constants]
-A = 2.0
-I_y = 0.5
-I_z = 8.0
-J = 0.2
-deck_y = [-3.0, 3.0]
-[bridge.damping]
-ratios = [0.02, 0.02]
-modes = ["vertical-1", "torsion-1"]
-[[sensors]]
-name = "mid"
-x = 10.0
-[[sensors]]
-name = "mid_left_acc"
-x = 10.0
-y = 2.0
-quantity = "acceleration"
-[[vehicles]]
-id = "truck"
-model = "quarter-car"
-m_v = 1000.0
-m_w = 100.0
-k_v = 4e4
-c_v = 5e3
-y = 1.5
-speed = 10.0
-[[vehicles]]
-id = "car"
-model = "golden-car"
-m_v = 300.0
-y = -1.5
-speed = 25.0
-entry_time = 0.5
-direction = "-x"
-[road]
-class = "H"
-seed = 7
-[solver]
-dt = 0.002
-"""
+CARS = TWO_CARS.replace('name = "two-cars"', 'name = "cars"')
 
 # The same bridge with a measured road profile next to the scenario (an input
 # file the log must carry) and a different name.
@@ -95,18 +46,6 @@ OTHER = (CARS.replace('name = "cars"', 'name = "other"').replace("spans = [20.0]
 # A run long enough to be stopped from outside: one slow car, 10 000 s, every step logged.
 LONG = (CARS.replace('name = "cars"', 'name = "long"').replace("speed = 25.0", "speed = 0.05")
         .replace("[solver]\ndt = 0.002", "[solver]\ndt = 0.002\nduration = 10000.0\n[output]\nevery = 1"))
-
-
-def env() -> dict[str, str]:
-    environ = dict(os.environ)
-    environ["PYTHONPATH"] = os.pathsep.join([str(REPO), environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    environ["MPLBACKEND"] = "Agg"
-    return environ
-
-
-def cosim_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd,
-                          env=env(), timeout=300)
 
 
 def write(folder: Path, name: str, text: str) -> Path:
@@ -300,7 +239,7 @@ def start_long_run(folder: Path) -> tuple[subprocess.Popen[str], Path]:
         signal.signal(signal.SIGINT, signal.SIG_DFL)
 
     proc = subprocess.Popen([sys.executable, "-m", "cosim", "run", str(scenario), "--out", str(log)],
-                            cwd=folder, env=env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            cwd=folder, env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             preexec_fn=default_sigint)
     deadline = time.monotonic() + 60
     while not (log.exists() and log.stat().st_size > 600_000):  # a few chunks are on disk

@@ -16,71 +16,11 @@ from cosim import cli, runner
 from cosim.errors import ModelError
 from cosim.log import TOPIC_SENSORS, read_log
 
-REPO = Path(cosim.__file__).resolve().parents[1]
+from _cli import REPO, TWO_CARS, cosim_cli
 
-
-def cosim_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m cosim ARGS`` against this checkout in ``cwd``."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    return subprocess.run(
-        [sys.executable, "-m", "cosim", *args], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
-    )
-
-# A 20 m single span with explicit constants and 8 elements (fast to build and
-# run): a quarter-car along +x and a golden car along -x on a class H road
-# (very rough: the light wheels lose contact), sampled every 5th step. No
-# duration: the run lasts until the last vehicle leaves (2.0 s) + 2 s.
-TWO_CARS = """\
-name = "two-cars"
-[bridge]
-spans = [20.0]
-elements_per_span = 8
-supports = ["pinned", "fork"]
-[bridge.material]
-E = 30e9
-nu = 0.2
-rho = 2500
-[bridge.section.constants]
-A = 2.0
-I_y = 0.5
-I_z = 8.0
-J = 0.2
-deck_y = [-3.0, 3.0]
-[bridge.damping]
-ratios = [0.02, 0.02]
-modes = ["vertical-1", "torsion-1"]
-[[sensors]]
-name = "mid"
-x = 10.0
-[[sensors]]
-name = "mid_left_acc"
-x = 10.0
-y = 2.0
-quantity = "acceleration"
-[[vehicles]]
-model = "quarter-car"
-m_v = 1000.0
-m_w = 100.0
-k_v = 4e4
-c_v = 5e3
-y = 1.5
-speed = 10.0
-[[vehicles]]
-model = "golden-car"
-m_v = 300.0
-y = -1.5
-speed = 25.0
-entry_time = 0.5
-direction = "-x"
-[road]
-class = "H"
-seed = 7
-[solver]
-dt = 0.002
-[output]
-every = 5
-"""
+# The shared two cars without ids (they are V1, V2 by position) and sampled every 5th step.
+TWO_CARS = (TWO_CARS.replace('id = "truck"\n', "").replace('id = "car"\n', "")
+            + "[output]\nevery = 5\n")
 STEPS = 2000  # 4 s at 2 ms
 ROWS = STEPS // 5 + 1  # every 5th step, and t = 0
 

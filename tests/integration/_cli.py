@@ -1,0 +1,81 @@
+"""Shared by the command-line tests: run ``python -m cosim`` against this checkout, and a small scenario."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import cosim
+
+REPO = Path(cosim.__file__).resolve().parents[1]
+
+
+def cli_env() -> dict[str, str]:
+    """The environment of a cosim subprocess: this checkout first on the path, no display for plots."""
+    environ = dict(os.environ)
+    environ["PYTHONPATH"] = os.pathsep.join([str(REPO), environ.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    environ["MPLBACKEND"] = "Agg"
+    return environ
+
+
+def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m cosim ARGS`` against this checkout in ``cwd`` (default: the checkout)."""
+    return subprocess.run([sys.executable, "-m", "cosim", *args], capture_output=True, text=True,
+                          cwd=cwd or REPO, env=cli_env(), timeout=300)
+
+
+# A 20 m single span with explicit constants and 8 elements (fast to build and
+# run): a quarter-car along +x and a golden car along -x on a class H road
+# (very rough: the light wheels lose contact), dt = 2 ms. No duration: the run
+# lasts until the last vehicle leaves (2.0 s) + 2 s.
+TWO_CARS = """\
+name = "two-cars"
+[bridge]
+spans = [20.0]
+elements_per_span = 8
+supports = ["pinned", "fork"]
+[bridge.material]
+E = 30e9
+nu = 0.2
+rho = 2500
+[bridge.section.constants]
+A = 2.0
+I_y = 0.5
+I_z = 8.0
+J = 0.2
+deck_y = [-3.0, 3.0]
+[bridge.damping]
+ratios = [0.02, 0.02]
+modes = ["vertical-1", "torsion-1"]
+[[sensors]]
+name = "mid"
+x = 10.0
+[[sensors]]
+name = "mid_left_acc"
+x = 10.0
+y = 2.0
+quantity = "acceleration"
+[[vehicles]]
+id = "truck"
+model = "quarter-car"
+m_v = 1000.0
+m_w = 100.0
+k_v = 4e4
+c_v = 5e3
+y = 1.5
+speed = 10.0
+[[vehicles]]
+id = "car"
+model = "golden-car"
+m_v = 300.0
+y = -1.5
+speed = 25.0
+entry_time = 0.5
+direction = "-x"
+[road]
+class = "H"
+seed = 7
+[solver]
+dt = 0.002
+"""
