@@ -970,7 +970,91 @@ def build_parser() -> argparse.ArgumentParser:
                           help="folder for report.md and the plots (default: validation)")
     validate.add_argument("--quick", action="store_true", help="coarser settings (seconds instead of a minute)")
     validate.set_defaults(func=_cmd_validate)
+
+    study = commands.add_parser(
+        "study",
+        help="traffic-volume studies: a base scenario swept over demand, trucks, speed, road and seeds, on Dask",
+        description=textwrap.dedent(
+            """\
+            Run every combination of the sweep axes of STUDY.toml (vehicles per hour, truck
+            share, speed limit, SUMO demand, road class, seeds) on a Dask cluster, each run
+            logged to MCAP, and write one table of results (results.csv, results.parquet)
+            and plots into the output folder (default studies/<name>/). Running the same
+            command again resumes: runs whose logs are complete are not run again. A
+            failing run is recorded in the table; the others go on. docs/studies.md
+            documents the study file and the output folder.
+
+            Exit status: 0 every run ok, 1 some run failed (see the table), 2 bad input,
+            130 interrupted (the same command resumes)."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim study examples/studies/volumes.toml
+              cosim study examples/studies/volumes.toml --workers 2 --out /data/volumes
+              cosim study examples/studies/volumes.toml --scheduler tcp://10.0.0.5:8786
+            """
+        ),
+        formatter_class=formatter,
+    )
+    study.add_argument("study", metavar="STUDY.toml", help="the study file")
+    study.add_argument("--workers", "-w", type=int, metavar="N",
+                       help="worker processes of the local Dask cluster (default: one per CPU; 0: run one "
+                            "after another in this process, without Dask)")
+    study.add_argument("--scheduler", metavar="ADDRESS",
+                       help="submit to an existing Dask scheduler (tcp://HOST:PORT) instead of a local cluster; "
+                            "its workers need cosim and the output folder at the same path")
+    study.add_argument("--out", metavar="FOLDER", help="the output folder (default: [study].output, else studies/<name>)")
+    study.add_argument("--redo", action="store_true", help="run every run again, even those already done")
+    study.add_argument("--no-plots", action="store_true", help="write the table only")
+    study.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
+    study.set_defaults(func=_cmd_study)
     return parser
+
+
+def _cmd_study(args: argparse.Namespace) -> int:
+    from .studies import load_study, run_study, summary_text
+
+    study = load_study(args.study, output=args.out)
+    bar: Any = None
+    failures: list[str] = []
+
+    def progress(done: int, total: int, row: dict | None) -> None:
+        nonlocal bar
+        if row is not None and row.get("status") != "ok":
+            failures.append(row["run_id"])
+        if args.quiet:
+            return
+        if not sys.stderr.isatty():  # a log file: one line per finished run
+            if row is not None:
+                state = "ok" if row.get("status") == "ok" else f"FAILED: {(row.get('error') or '').splitlines()[0]}"
+                print(f"run {done}/{total} {row['run_id']}: {state}", file=sys.stderr, flush=True)
+            elif done:
+                print(f"{done} of {total} runs done earlier", file=sys.stderr, flush=True)
+            return
+        if bar is None:
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, initial=done, file=sys.stderr, desc=f"Study {study.name}", unit="run",
+                       dynamic_ncols=True,
+                       bar_format="{desc}: {n}/{total} runs |{bar}| [{elapsed}<{remaining}]{postfix}")
+        if failures:
+            bar.set_postfix_str(f"{len(failures)} failed", refresh=False)
+        bar.update(done - bar.n)
+
+    try:
+        outcome = run_study(study, workers=args.workers, scheduler=args.scheduler, progress=progress,
+                            redo=args.redo, plots=False if args.no_plots else None)
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
+        print(f"cosim: interrupted; the runs finished so far are in {study.output / 'results.csv'}; "
+              "run the same command again to resume", file=sys.stderr)
+        return 130
+    if bar is not None:
+        bar.close()
+    print(summary_text(outcome))
+    return 1 if outcome.failed else 0
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:

@@ -1,0 +1,409 @@
+"""``cosim study``: traffic-volume studies on Dask, with real SUMO and real MCAP logs.
+
+A small study (2 volumes x 2 seeds of 60 s on a coarse 40 m girder) runs on a
+local cluster of 2 worker processes; its rows are checked against the same
+scenarios run one by one in this process, against a 1-worker cluster, and
+against a scheduler and workers started as separate processes. Then: a study
+interrupted with Ctrl-C resumes, and a run with a broken SUMO file is
+reported while the others finish.
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import cosim
+from cosim.errors import ConfigError
+from cosim.log import file_is_complete
+from cosim.runner import compare_sensors, run_logged
+from cosim.scenario import load_scenario
+from cosim.studies import load_study, parse_study, run_study, summary_text
+from cosim.sumo import bundled_networks
+
+REPO = Path(cosim.__file__).resolve().parents[1]
+
+# The bundled network's 40 m bridge as a coarse girder: 10 elements, dt = 25 ms
+# (two sub-steps per SUMO step), logged at 40 Hz.
+BASE = """\
+name = "small"
+[bridge]
+spans = [40.0]
+elements_per_span = 10
+supports = ["pinned", "fork"]
+[bridge.material]
+E = 35e9
+nu = 0.2
+rho = 2500.0
+[bridge.section.constants]
+A = 6.0
+I_y = 3.0
+I_z = 50.0
+J = 5.0
+z_c = -0.8
+deck_y = [-5.0, 5.0]
+[bridge.damping]
+ratios = [0.02, 0.02]
+modes = ["vertical-1", "torsion-1"]
+[[sensors]]
+name = "mid"
+x = 20.0
+y = -1.875
+[[sensors]]
+name = "mid_moment"
+x = 20.0
+quantity = "bending_moment"
+[[sensors]]
+name = "mid_acc"
+x = 20.0
+quantity = "acceleration"
+[traffic]
+sumo_config = "medium"
+step = 0.05
+end = 600.0
+seed = 42
+axis = [[0.0, 0.0], [40.0, 0.0]]
+[solver]
+dt = 0.025
+[output]
+rate_hz = 40.0
+"""
+
+STUDY = """\
+[study]
+name = "small"
+base = "base.toml"
+duration = 60.0
+[sweep]
+vehicles_per_hour = [300.0, 900.0]
+seeds = [1, 2]
+"""
+
+WALL = ("wall_time", "wall_time_total")
+
+
+def _write_study(folder: Path, study: str = STUDY, base: str = BASE) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "base.toml").write_text(base)
+    path = folder / "study.toml"
+    path.write_text(study)
+    return path
+
+
+def _numbers(frame: pd.DataFrame) -> pd.DataFrame:
+    """The table without wall times: what must not depend on how the runs were executed."""
+    return frame[[c for c in frame.columns if c not in WALL]].reset_index(drop=True)
+
+
+@pytest.fixture(scope="module")
+def on_two_workers(tmp_path_factory):
+    """The small study on a local cluster of 2 worker processes."""
+    folder = tmp_path_factory.mktemp("study")
+    study = load_study(_write_study(folder), output=folder / "out")
+    seen = []
+    outcome = run_study(study, workers=2, progress=lambda done, total, row: seen.append((done, total)))
+    return study, outcome, seen
+
+
+def test_two_volumes_two_seeds_on_two_workers_give_four_rows(on_two_workers):
+    study, outcome, seen = on_two_workers
+    assert outcome.workers == 2
+    assert [r["run_id"] for r in outcome.rows] == [
+        "vph-300_seed-1", "vph-300_seed-2", "vph-900_seed-1", "vph-900_seed-2"]
+    assert outcome.failed == [] and len(outcome.ran) == 4 and outcome.skipped == []
+    assert seen[0] == (0, 4) and seen[-1] == (4, 4) and len(seen) == 5
+    csv = pd.read_csv(outcome.table_csv, dtype={"error": str})
+    csv["error"] = csv["error"].fillna("")  # an empty CSV cell reads as NaN
+    parquet = pd.read_parquet(outcome.table_parquet)
+    assert len(csv) == len(parquet) == 4
+    pd.testing.assert_frame_equal(csv, parquet, check_dtype=False)
+    for column in ("vehicles_per_hour", "seed", "sumo_seed", "mid.peak", "mid.p95", "mid.rms", "mid.daf",
+                   "mid_moment.daf", "mid_acc.rms", "vehicles", "max_on_deck", "heaviest_kg", "liftoff_events",
+                   "wall_time", "status"):
+        assert column in csv.columns, column
+    assert (csv["status"] == "ok").all()
+    assert csv["mid_acc.daf"].isna().all()  # no quasi-static counterpart for accelerations
+    # More traffic, more vehicles (same seed).
+    by = csv.set_index("run_id")
+    for seed in (1, 2):
+        assert by.loc[f"vph-900_seed-{seed}", "vehicles"] > by.loc[f"vph-300_seed-{seed}", "vehicles"]
+    assert (csv["vehicles"] > 0).all()
+    assert ((csv["mid.daf"] > 0.95) & (csv["mid.daf"] < 1.5)).all()
+    for name in ("mid.peak.png", "mid.daf.png", "mid_acc.rms.png", "vehicles.png"):
+        assert (outcome.study.output / "plots" / name).stat().st_size > 1000, name
+    run = outcome.study.output / "runs" / "vph-900_seed-2"
+    assert {p.name for p in run.iterdir()} >= {"scenario.toml", "run.mcap", "result.json", "sumo"}
+    assert 'vehsPerHour="900"' in (run / "sumo" / "medium.rou.xml").read_text()
+
+
+def test_the_rows_are_the_runs_one_by_one(on_two_workers, tmp_path):
+    """Each generated scenario, run by itself in this process, gives the row's numbers exactly."""
+    study, outcome, _ = on_two_workers
+    for row in outcome.rows:
+        folder = study.output / "runs" / row["run_id"]
+        scenario = load_scenario(folder / "scenario.toml")
+        alone = run_logged(scenario, tmp_path / f"{row['run_id']}.mcap")
+        for name in ("mid", "mid_moment", "mid_acc"):
+            assert row[f"{name}.min"] == alone.result.sensor_min[name]
+            assert row[f"{name}.max"] == alone.result.sensor_max[name]
+        assert row["vehicles"] == len(alone.result.vehicle_ids)
+        assert row["max_on_deck"] == alone.result.max_on_deck
+        assert row["liftoff_events"] == alone.result.liftoff_events
+        assert compare_sensors(folder / "run.mcap", alone.log_path).identical
+
+
+def test_the_numbers_do_not_depend_on_the_number_of_workers(on_two_workers, tmp_path):
+    study, outcome, _ = on_two_workers
+    again = run_study(load_study(study.source, output=tmp_path / "one"), workers=1, plots=False)
+    assert again.workers == 1
+    pd.testing.assert_frame_equal(_numbers(again.table()).drop(columns="log"),
+                                  _numbers(outcome.table()).drop(columns="log"))
+
+
+def test_a_second_run_of_the_same_study_redoes_nothing(on_two_workers):
+    study, outcome, _ = on_two_workers
+    logs = {r: (study.output / "runs" / r / "run.mcap").stat().st_mtime_ns for r in outcome.ran}
+    again = run_study(load_study(study.source, output=study.output), workers=2, plots=False)
+    assert again.ran == [] and again.skipped == outcome.ran and again.workers == 0
+    assert again.rows == outcome.rows
+    assert logs == {r: (study.output / "runs" / r / "run.mcap").stat().st_mtime_ns for r in outcome.ran}
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _dask(*args: str, cwd: Path) -> subprocess.Popen:
+    return subprocess.Popen(["dask", *args], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+
+
+def test_a_study_on_a_separately_started_scheduler(on_two_workers, tmp_path):
+    """``dask scheduler`` and ``dask worker`` processes started apart, in a folder of their own."""
+    from dask.distributed import Client
+
+    if shutil.which("dask") is None:
+        pytest.fail("the `dask` command (dask[distributed]) is not on PATH")
+    study, outcome, _ = on_two_workers
+    elsewhere = tmp_path / "elsewhere"  # the workers' working folder: not the caller's
+    elsewhere.mkdir()
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    port = address.rsplit(":", 1)[1]
+    scheduler = _dask("scheduler", "--host", "127.0.0.1", "--port", port, "--no-dashboard", cwd=elsewhere)
+    worker = None
+    try:
+        worker = _dask("worker", address, "--nworkers", "2", "--nthreads", "1", "--no-dashboard", cwd=elsewhere)
+        with Client(address, timeout="30s") as client:
+            client.wait_for_workers(2, timeout=60)
+        remote = run_study(load_study(study.source, output=tmp_path / "remote"), scheduler=address, plots=False)
+    finally:
+        for proc in (worker, scheduler):
+            if proc is not None:
+                os.killpg(proc.pid, signal.SIGTERM)
+        for proc in (worker, scheduler):
+            if proc is not None:
+                try:
+                    proc.wait(timeout=20)
+                except subprocess.TimeoutExpired:
+                    os.killpg(proc.pid, signal.SIGKILL)
+    assert remote.workers == 2 and remote.failed == []
+    pd.testing.assert_frame_equal(_numbers(remote.table()).drop(columns="log"),
+                                  _numbers(outcome.table()).drop(columns="log"))
+    assert not any(elsewhere.glob("**/*.mcap"))  # every log went to the output folder
+
+
+RUN_STUDY = """\
+import sys
+from cosim.studies import load_study, run_study
+if __name__ == "__main__":
+    run_study(load_study(sys.argv[1], output=sys.argv[2]), workers=1, plots=False)
+"""
+
+
+def _ok_runs(out: Path) -> dict[str, int]:
+    found = {}
+    for path in out.glob("runs/*/result.json"):
+        try:
+            if json.loads(path.read_text())["row"]["status"] == "ok":
+                found[path.parent.name] = (path.parent / "run.mcap").stat().st_mtime_ns
+        except (OSError, ValueError, KeyError):
+            pass
+    return found
+
+
+def test_an_interrupted_study_resumes_without_redoing_finished_runs(tmp_path):
+    """Ctrl-C after the first finished run; the same command again runs only the rest."""
+    study_path = _write_study(tmp_path, STUDY.replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "seeds = [1, 2, 3, 4]"))
+    out = tmp_path / "out"
+    script = tmp_path / "go.py"
+    script.write_text(RUN_STUDY)
+    proc = subprocess.Popen([sys.executable, str(script), str(study_path), str(out)], cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    started = time.monotonic()
+    while not _ok_runs(out) and time.monotonic() - started < 120 and proc.poll() is None:
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode != 0, f"the study finished before it was interrupted:\n{err[-2000:]}"
+    assert "KeyboardInterrupt" in err
+    finished = _ok_runs(out)
+    assert 1 <= len(finished) < 4
+    # The table of the finished runs is written on the way out.
+    assert set(pd.read_csv(out / "results.csv")["run_id"]) == set(finished)
+    # A run cut short (its log truncated, no result) must run again, whatever state it was left in.
+    cut = sorted(finished)[-1]
+    if len(finished) >= 2:
+        log = out / "runs" / cut / "run.mcap"
+        log.write_bytes(log.read_bytes()[: log.stat().st_size // 2])
+        assert not file_is_complete(log)
+        del finished[cut]
+    resumed = run_study(load_study(study_path, output=out), workers=0, plots=False)
+    assert sorted(resumed.skipped) == sorted(finished)
+    assert sorted(resumed.ran) == sorted(set(f"seed-{s}" for s in (1, 2, 3, 4)) - set(finished))
+    assert resumed.failed == []
+    assert {k: v for k, v in _ok_runs(out).items() if k in finished} == finished  # logs not rewritten
+    assert len(pd.read_csv(out / "results.csv")) == 4
+
+
+def _broken_sumo(folder: Path) -> Path:
+    """A SUMO config on the bundled network whose route names an edge the network does not have."""
+    folder.mkdir(parents=True)
+    for name in ("bridge.net.xml", "vtypes.add.xml"):
+        shutil.copy(bundled_networks() / name, folder / name)
+    (folder / "broken.rou.xml").write_text(
+        '<routes>\n  <flow id="east" type="mix" begin="0" end="3600" vehsPerHour="300" from="in_e" to="nowhere"/>\n'
+        '</routes>\n')
+    cfg = folder / "broken.sumocfg"
+    cfg.write_text('<configuration><input><net-file value="bridge.net.xml"/>'
+                   '<route-files value="vtypes.add.xml,broken.rou.xml"/></input></configuration>')
+    return cfg
+
+
+def test_a_failing_run_is_reported_and_the_others_finish(tmp_path):
+    _broken_sumo(tmp_path / "mine")
+    study_path = _write_study(tmp_path, STUDY.replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]",
+        'sumo_config = ["light", "mine/broken.sumocfg"]\nseeds = [1]'))
+    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=2)
+    table = pd.read_csv(outcome.table_csv).set_index("run_id")
+    assert list(table.index) == ["cfg-light_seed-1", "cfg-broken_seed-1"]
+    assert outcome.failed == ["cfg-broken_seed-1"]
+    assert table.loc["cfg-light_seed-1", "status"] == "ok" and table.loc["cfg-light_seed-1", "vehicles"] > 0
+    assert table.loc["cfg-broken_seed-1", "status"] == "error"
+    assert "nowhere" in table.loc["cfg-broken_seed-1", "error"]
+    assert np.isnan(table.loc["cfg-broken_seed-1", "mid.peak"])
+    assert (tmp_path / "out" / "plots" / "mid.peak.png").is_file()  # from the runs that worked
+    summary = summary_text(outcome)
+    assert "Runs: 2: 2 run now on 2 workers, 0 reused from earlier, 1 failed" in summary
+    assert "  cfg-broken_seed-1: " in summary and "nowhere" in summary
+    # Re-running retries the failed run only.
+    again = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
+    assert again.ran == ["cfg-broken_seed-1"] and again.skipped == ["cfg-light_seed-1"]
+
+
+def test_a_broken_demand_file_fails_its_runs_only(tmp_path):
+    """A route file that is not XML cannot take the sweep's rate: those runs fail, before SUMO starts."""
+    cfg = _broken_sumo(tmp_path / "mine")
+    (cfg.parent / "broken.rou.xml").write_text("<routes><flow id='east'")
+    study_path = _write_study(tmp_path, STUDY.replace(
+        "seeds = [1, 2]", 'sumo_config = ["light", "mine/broken.sumocfg"]'))
+    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
+    status = {r["run_id"]: (r["status"], r.get("error", "")) for r in outcome.rows}
+    assert [k for k, (s, _) in status.items() if s == "ok"] == ["cfg-light_vph-300", "cfg-light_vph-900"]
+    for run_id in ("cfg-broken_vph-300", "cfg-broken_vph-900"):
+        assert status[run_id][0] == "error" and "broken.rou.xml: not well-formed XML" in status[run_id][1]
+
+
+def test_sweeping_the_speed_limit_slows_the_traffic(tmp_path):
+    from cosim.log import TOPIC_TRAFFIC, read_log
+
+    study_path = _write_study(tmp_path, STUDY.replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "speed_limit = [10.0, 25.0]\nseeds = [3]"))
+    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
+    assert outcome.failed == []
+    speeds = {}
+    for row in outcome.rows:
+        frames = read_log(outcome.study.output / row["log"], topics=[TOPIC_TRAFFIC]).topic(TOPIC_TRAFFIC)
+        on_deck = [abs(v) for f in frames for v, x in zip(f["speed"], f["x"]) if 0.0 <= x <= 40.0]
+        speeds[row["speed_limit"]] = np.mean(on_deck)
+    assert 7.0 < speeds[10.0] < 11.5 < 18.0 < speeds[25.0]
+
+
+def test_truck_share_changes_the_mix(tmp_path):
+    """All trucks vs no trucks: the heaviest vehicle on the deck tells which."""
+    study_path = _write_study(tmp_path, STUDY.replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "truck_share = [0.0, 1.0]\nvehicles_per_hour = [900.0]"))
+    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
+    rows = {r["truck_share"]: r for r in outcome.rows}
+    assert rows[0.0]["heaviest_kg"] <= 3000.0  # cars (1.5 t) and vans (3 t) only
+    assert rows[1.0]["heaviest_kg"] >= 11000.0
+    assert rows[1.0]["mid.peak"] > rows[0.0]["mid.peak"]
+
+
+def test_study_file_errors_name_the_file_and_the_key(tmp_path):
+    base = tmp_path / "base.toml"
+    base.write_text(BASE)
+    cases = {
+        '[study]\nbase = "base.toml"\nduraton = 60.0\n': 'study.duraton: unknown key; did you mean "duration"?',
+        '[study]\nbase = "base.toml"\n[sweep]\nvehicles_per_hour = [300, -5]\n':
+            "sweep.vehicles_per_hour[1]: must be > 0",
+        '[study]\nbase = "base.toml"\n[sweep]\ntruck_share = [1.5]\n': "sweep.truck_share[0]: must be <= 1",
+        '[study]\nbase = "base.toml"\n[sweep]\nroad_class = ["b"]\n': 'did you mean "B"?',
+        '[study]\nbase = "base.toml"\n[sweep]\nseeds = [1, 1]\n': "sweep.seeds: value 1 is listed twice",
+        '[study]\nbase = "nope.toml"\n': "nope.toml: no such scenario file",
+        '[study]\nbase = "base.toml"\n[sweep]\nsumo_config = ["nothere.sumocfg"]\n':
+            "sweep.sumo_config[0]: file not found",
+        '[study]\nbase = "paper-double-tee"\n[sweep]\nvehicles_per_hour = [300]\n':
+            "sweep.vehicles_per_hour: needs SUMO traffic",
+    }
+    for text, expected in cases.items():
+        path = tmp_path / "s.toml"
+        path.write_text(text)
+        with pytest.raises(ConfigError) as info:
+            load_study(path)
+        message = str(info.value)
+        assert message.startswith(str(path)) and expected in message, message
+
+
+def test_run_ids_follow_the_values_not_the_order_of_execution(tmp_path):
+    study = parse_study(STUDY.replace('base = "base.toml"', 'base = "paper-double-tee"').replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", 'road_class = ["smooth", "C"]\nseeds = 2'),
+        "s.toml", base_dir=tmp_path, output=tmp_path / "o")
+    tasks = study.tasks()
+    assert [t.run_id for t in tasks] == ["road-smooth_seed-1", "road-smooth_seed-2", "road-C_seed-1",
+                                         "road-C_seed-2"]
+    assert [t.fingerprint for t in tasks] == [t.fingerprint for t in study.tasks()]
+    assert tasks[2].parameters == {"road_class": "C", "seed": 1, "road_seed": 1}
+    assert 'class = "C"\nseed = 1' in tasks[2].scenario_text
+    assert "duration = 60.0" in tasks[0].scenario_text  # a scripted base: the study's duration is the run's
+
+
+def test_the_study_command(tmp_path):
+    """``cosim study`` as users run it: the table, the plots, exit 0; a bad study file: one line, exit 2."""
+    from _cli import cosim_cli
+
+    study_path = _write_study(tmp_path, STUDY.replace("vehicles_per_hour = [300.0, 900.0]",
+                                                      "vehicles_per_hour = [300.0]").replace("seeds = [1, 2]",
+                                                                                             "seeds = [1]"))
+    done = cosim_cli("study", str(study_path), "--workers", "0", "--quiet", "--out", "out", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    table = pd.read_csv(tmp_path / "out" / "results.csv")
+    assert len(table) == 1 and table["status"].tolist() == ["ok"]
+    assert any((tmp_path / "out" / "plots").glob("*.png"))
+    bad = tmp_path / "bad.toml"
+    bad.write_text(STUDY.replace("[sweep]", "[sweep]\nvehicle_per_hour = [1.0]"))
+    failed = cosim_cli("study", str(bad), "--quiet", cwd=tmp_path)
+    assert failed.returncode == 2 and "vehicle_per_hour" in failed.stderr and "Traceback" not in failed.stderr
