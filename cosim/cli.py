@@ -542,6 +542,15 @@ def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, ar
     return 0, outcome
 
 
+def _print_outcome(scenario: Scenario, outcome: runner.RunOutcome) -> None:
+    """The end-of-run summary: sensor peaks, vehicles, counters, the log written."""
+    print()
+    _print(_sensor_summary(scenario, outcome.result))
+    _print(_vehicle_summary(outcome))
+    _print(_run_lines(outcome))
+    print(_log_done_line(outcome))
+
+
 def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
     """With [[vehicles]]: the time simulation into an MCAP log, an optional sensor CSV and a summary."""
     default = scenario.log_path or runner.unique_path(scenario.default_log_path())
@@ -555,11 +564,7 @@ def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
     status, outcome = _simulate_logged(scenario, bridge, log_path, args)
     if outcome is None:
         return status
-    print()
-    _print(_sensor_summary(scenario, outcome.result))
-    _print(_vehicle_summary(outcome))
-    _print(_run_lines(outcome))
-    print(_log_done_line(outcome))
+    _print_outcome(scenario, outcome)
     if csv_path is not None:
         rows, columns = runner.export_csv(log_path, csv_path, force=args.force)
         print(f"Wrote {rows} rows to {csv_path} (columns {','.join(columns)}; SI units: m, m/s, m/s^2, N m)")
@@ -594,11 +599,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
                                            duration=plan.duration)
     if outcome is None:
         return status
-    print()
-    _print(_sensor_summary(scenario, outcome.result))
-    _print(_vehicle_summary(outcome))
-    _print(_run_lines(outcome))
-    print(_log_done_line(outcome))
+    _print_outcome(scenario, outcome)
     comparison = runner.compare_sensors(log, log_path)
     print()
     if plan.own:
