@@ -663,10 +663,11 @@ class BlockLogger:
         self.rec.write_encoded(TOPIC_VEHICLES, t.tolist(), out)
 
 class TrafficLogger:
-    """Frame sink for a live traffic source (SUMO): logs every frame and each new vehicle type.
+    """Frame sink for a live traffic source (SUMO): logs every frame with vehicles, and each new vehicle type.
 
     These are what :func:`traffic_from_log` needs to re-drive a bridge with
-    exactly the same vehicle kinematics (``cosim replay``).
+    exactly the same vehicle kinematics (``cosim replay``). A frame without
+    vehicles near the deck is not written: a missing frame is an empty one.
     """
 
     def __init__(self, recorder: LogRecorder) -> None:
@@ -679,28 +680,46 @@ class TrafficLogger:
                 self._types.add(typ)
                 self.rec.write(TOPIC_VEHICLE_TYPES, frame.t, {"t": frame.t, "type": typ,
                                                               "model": model_to_dict(models[typ])})
+        if not frame.ids:
+            return
         self.rec.write(TOPIC_TRAFFIC, frame.t, {
             "t": frame.t, "ids": list(frame.ids), "x": frame.x.tolist(), "y": frame.y.tolist(),
             "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
 
 
-def traffic_from_log(contents: LogContents, length: float, step: float) -> FrameTraffic:
+def traffic_from_log(contents: LogContents, length: float, step: float, until: float | None = None) -> FrameTraffic:
     """Rebuild the logged traffic frames as a traffic source for a bridge of ``length`` m.
 
+    Frames the log does not hold were empty (no vehicle near the deck); they
+    are filled in at their step times, up to ``until`` (s) if given.
+
     Raises:
-        LogError: the log has no traffic frames, or they are malformed.
+        LogError: the log has no traffic frames (and no ``until``), or they are malformed.
     """
     frames = contents.topic(TOPIC_TRAFFIC)
-    if not frames:
+    if not frames and until is None:
         raise LogError(f"{contents.path}: no traffic frames ({TOPIC_TRAFFIC}) in this log")
+    empty = np.zeros(0)
+
+    def pad(traffic: FrameTraffic, t_end: float) -> None:
+        """Empty frames while one more still ends before ``t_end`` (half a step of slack for round-off)."""
+        # Same time expression as the live source (k * step), so replays are bit-identical.
+        while traffic.last_time + step < t_end + 0.5 * step:
+            k = int(round(traffic.last_time / step)) + 1
+            traffic.add_frame(Frame(k * step, (), empty, empty, empty, empty, ()))
+
     try:
         models = {m["type"]: model_from_dict(m["model"]) for m in contents.topic(TOPIC_VEHICLE_TYPES)}
         traffic = FrameTraffic(step, length, models)
         for f in frames:
+            t = float(f["t"])
+            pad(traffic, t - step)
             traffic.add_frame(Frame(
-                t=float(f["t"]), ids=tuple(f["ids"]), x=np.array(f["x"], dtype=float), y=np.array(f["y"], dtype=float),
+                t=t, ids=tuple(f["ids"]), x=np.array(f["x"], dtype=float), y=np.array(f["y"], dtype=float),
                 v=np.array(f["speed"], dtype=float), a=np.array(f["acceleration"], dtype=float),
                 types=tuple(f["types"])))
+        if until is not None:
+            pad(traffic, until)
     except (KeyError, TypeError, ValueError, ConfigError) as exc:
         raise LogError(f"{contents.path}: malformed traffic frames ({exc})") from None
     return traffic

@@ -968,8 +968,10 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     except (KeyError, ValueError, TypeError, AttributeError):
         raise LogError(f"{overview.path}: malformed cosim metadata (duration or traffic step)") from None
     contents = read_log(overview.path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-    traffic = traffic_from_log(contents, plan.scenario.bridge.length, step)
-    duration = min(duration, traffic.last_time)  # a cut-off log: as far as its frames go
+    # Frames are logged only while vehicles are near the deck: pad to the logged run's end, or,
+    # for a cut-off log, to the last time the log reached.
+    duration = min(duration, overview.end_time) if overview.end_time > 0 else duration
+    traffic = traffic_from_log(contents, plan.scenario.bridge.length, step, until=duration)
     record["traffic"] = f"{len(contents.messages.get(TOPIC_TRAFFIC, []))} logged SUMO frames"
     return ReplayPlan(plan.scenario, overview, plan.own, record, plan.attachments, traffic, duration)
 
