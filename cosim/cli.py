@@ -774,7 +774,7 @@ def build_parser() -> argparse.ArgumentParser:
             fractions for vertical, lateral and torsional motion."""
         ),
         epilog=textwrap.dedent(
-            f"""\
+            """\
             examples:
               cosim modes paper-double-tee
               cosim modes paper-double-tee --count 20 --json > modes.json

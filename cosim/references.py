@@ -270,3 +270,29 @@ def sprung_mass_modal_solution(
     w_mid = (norm * np.sin(n * np.pi / 2)) @ sol.y[:n_modes]
     body_acc = np.array([rhs(t, s)[-1] for t, s in zip(sol.t, sol.y.T)])
     return w_mid, body_acc
+
+
+# Yang & Yau (1997) moving sprung mass: L 25 m, EI 2.943e10 N m2, m 2303 kg/m,
+# sprung mass 5750 kg on k 1.595e6 N/m (no damping), 100 km/h.
+YANG_YAU = {"L": 25.0, "EI": 2.943e10, "m": 2303.0, "m_v": 5750.0, "k_v": 1.595e6, "c_v": 0.0, "v": 27.78}
+
+
+def yang_yau_case():
+    """The Yang & Yau sprung-mass benchmark as a cosim model: (bridge, traffic, crossing time T).
+
+    The section makes EI and m match with negligible rotary inertia (I/A =
+    1e-3 m^2) and shear flexibility, so the Euler-Bernoulli modal reference
+    (:func:`sprung_mass_modal_solution`) applies.
+    """
+    from .bridge import build_bridge
+    from .traffic import ScriptedTraffic, ScriptedVehicle
+    from .vehicles import QuarterCar
+
+    p = YANG_YAU
+    mat = Material(E=p["EI"] / 1e-3, G=1e12, rho=p["m"])
+    sec = SectionProperties(A=1.0, y_c=0, z_c=0, I_y=1e-3, I_z=1e-3, I_yz=0, y_s=0, z_s=0, J=1e-3, I_w=0,
+                            A_sy=1e6, A_sz=1e6, deck_y=(-1.0, 1.0))
+    bridge = build_bridge([p["L"]], 40, mat, sec, ["pinned", "fork"])
+    car = QuarterCar(m_v=p["m_v"], m_w=0.0, k_v=p["k_v"], c_v=p["c_v"])
+    traffic = ScriptedTraffic((ScriptedVehicle("S", car, 0.0, p["v"]),), p["L"])
+    return bridge, traffic, p["L"] / p["v"]

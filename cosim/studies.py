@@ -734,9 +734,8 @@ def _sensor_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentile
     names = [s.name for s in sensors]
     _, series = sensor_series(outcome.log_path, names)
     contents = read_log(outcome.log_path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-    if contents.topic(TOPIC_TRAFFIC):
-        step = float(contents.topic(TOPIC_TRAFFIC)[0]["t"])
-        traffic = traffic_from_log(contents, bridge.length, step)
+    if scenario.traffic is not None:  # the logged SUMO frames (empty ones are not in the log)
+        traffic = traffic_from_log(contents, bridge.length, scenario.traffic.step, until=outcome.duration)
     else:
         traffic = scenario.build_vehicles()
     qs = quasi_static(bridge, traffic, outcome.duration, scenario.solver.dt, sensors, scenario.solver.gravity)

@@ -303,10 +303,10 @@ class Results:
         if self.log_path is not None:
             from .log import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, read_log, traffic_from_log
 
-            contents = read_log(self.log_path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-            frames = contents.topic(TOPIC_TRAFFIC)
-            if frames:
-                return traffic_from_log(contents, self.bridge.length, float(frames[0]["t"]))
+            traffic_cfg = self.scenario.traffic
+            if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)
+                contents = read_log(self.log_path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
+                return traffic_from_log(contents, self.bridge.length, traffic_cfg.step, until=self.duration)
         return self.scenario.build_vehicles()
 
     def static(self, name: str) -> npt.NDArray[np.float64]:

@@ -10,7 +10,7 @@ gone. :class:`ScriptedTraffic` is the source for runs without SUMO.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol, Sequence
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt

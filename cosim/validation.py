@@ -37,6 +37,8 @@ from .element import DOF_INDEX, NODE_DOFS
 from .errors import CosimError
 from .references import (
     STEEL,
+    YANG_YAU,
+    yang_yau_case,
     cantilever_tip_load_deflection,
     doubly_symmetric_section,
     euler_bernoulli_ss_frequency_hz,
@@ -50,7 +52,7 @@ from .references import (
     timoshenko_ss_frequency_hz,
     torsional_frequencies_hz,
 )
-from .section import Material, SectionProperties
+from .section import SectionProperties
 from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 
 __all__ = ["CaseResult", "ValidationReport", "ValidationSettings", "run_validation", "study_names"]
@@ -772,20 +774,12 @@ def _study_fryba(run: _Run) -> list[CaseResult]:
 
 def _study_sprung_mass(run: _Run) -> list[CaseResult]:
     from .simulation import Sensor, SolverSettings, simulate
-    from .traffic import ScriptedTraffic, ScriptedVehicle
 
     group = "Moving sprung mass"
     s = run.settings
     # Yang & Yau (1997): L 25 m, EI 2.943e10 N m2, m 2303 kg/m, sprung mass 5750 kg, k 1.595e6 N/m, 100 km/h.
-    L, EI, m = 25.0, 2.943e10, 2303.0
-    m_v, k_v, c_v, v = 5750.0, 1.595e6, 0.0, 27.78
-    mat = Material(E=EI / 1e-3, G=1e12, rho=m)
-    sec = SectionProperties(A=1.0, y_c=0, z_c=0, I_y=1e-3, I_z=1e-3, I_yz=0, y_s=0, z_s=0, J=1e-3, I_w=0,
-                            A_sy=1e6, A_sz=1e6, deck_y=(-1.0, 1.0))
-    bridge = build_bridge([L], 40, mat, sec, ["pinned", "fork"])
-    T = L / v
-    car = QuarterCar(m_v=m_v, m_w=0.0, k_v=k_v, c_v=c_v)
-    traffic = ScriptedTraffic((ScriptedVehicle("S", car, 0.0, v),), L)
+    bridge, traffic, T = yang_yau_case()
+    L, EI, m, m_v, k_v, c_v, v = (YANG_YAU[k] for k in ("L", "EI", "m", "m_v", "k_v", "c_v", "v"))
     res = simulate(bridge, traffic, T, SolverSettings(dt=T / s.sprung_steps, gravity=GRAVITY), [Sensor("mid", L / 2)])
     w_ref, acc_ref = sprung_mass_modal_solution(res.t, L, EI, m, m_v, k_v, c_v, v, gravity=GRAVITY,
                                                 n_modes=s.sprung_modes, rtol=s.sprung_rtol, atol=s.sprung_rtol * 1e-3)

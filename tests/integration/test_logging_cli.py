@@ -27,7 +27,7 @@ from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES,
 from cosim.runner import toml_dumps
 from cosim.scenario import load_scenario
 
-from _cli import REPO, TWO_CARS, cli_env, cosim_cli
+from _cli import TWO_CARS, cli_env, cosim_cli
 
 # A 20 m span with explicit constants (fast to build): a quarter-car along +x
 # and a golden car along -x on a class H road (the light wheels lift off),

@@ -3,20 +3,16 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 import re
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-import cosim
 from cosim import cli, runner
 from cosim.errors import ModelError
 from cosim.log import TOPIC_SENSORS, read_log
 
-from _cli import REPO, TWO_CARS, cosim_cli
+from _cli import TWO_CARS, cosim_cli
 
 # The shared two cars without ids (they are V1, V2 by position) and sampled every 5th step.
 TWO_CARS = (TWO_CARS.replace('id = "truck"\n', "").replace('id = "car"\n', "")

@@ -1,7 +1,6 @@
 """Vehicle-bridge interaction against closed forms and independent solutions (DESIGN.md section 8)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -9,8 +8,7 @@ import pytest
 from cosim.bridge import ExplicitDamping, PointLoad, build_bridge
 from cosim.coupling import CoupledSystem
 from cosim.integrator import Scheme, make_basis
-from cosim.references import fryba_midspan_deflection, sprung_mass_modal_solution
-from cosim.section import Material, SectionProperties
+from cosim.references import YANG_YAU, fryba_midspan_deflection, sprung_mass_modal_solution, yang_yau_case
 from cosim.simulation import Sensor, SolverSettings, simulate
 from cosim.traffic import ScriptedTraffic, ScriptedVehicle, TrafficFrame
 from cosim.vehicles import MovingForce, QuarterCar, TyreQuarterCar
@@ -52,16 +50,8 @@ def test_moving_force_matches_frybas_series(speed_parameter, basis):
 
 def test_sprung_mass_matches_an_independent_modal_solution():
     """Yang & Yau (1997) sprung-mass example against a continuous-beam modal ODE solved by solve_ivp."""
-    L, EI, m = 25.0, 2.943e10, 2303.0
-    m_v, k_v, c_v, v = 5750.0, 1.595e6, 0.0, 27.78
-    # Section chosen so that EI and m match and rotary inertia (I/A = 1e-3 m^2) is negligible.
-    mat = Material(E=EI / 1e-3, G=1e12, rho=m)
-    sec = SectionProperties(A=1.0, y_c=0, z_c=0, I_y=1e-3, I_z=1e-3, I_yz=0, y_s=0, z_s=0, J=1e-3, I_w=0,
-                            A_sy=1e6, A_sz=1e6, deck_y=(-1.0, 1.0))
-    bridge = build_bridge([L], 40, mat, sec, ["pinned", "fork"])
-    T = L / v
-    car = QuarterCar(m_v=m_v, m_w=0.0, k_v=k_v, c_v=c_v)
-    traffic = ScriptedTraffic((ScriptedVehicle("S", car, 0.0, v),), L)
+    bridge, traffic, T = yang_yau_case()  # EI and m as the paper's, negligible rotary inertia and shear
+    L, EI, m, m_v, k_v, c_v, v = (YANG_YAU[k] for k in ("L", "EI", "m", "m_v", "k_v", "c_v", "v"))
     res = simulate(bridge, traffic, T, SolverSettings(dt=T / 4000), [Sensor("mid", L / 2)])
 
     # 20 mass-normalised sine modes of the continuous beam, solve_ivp (DOP853, rtol 1e-10).
