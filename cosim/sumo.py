@@ -207,6 +207,10 @@ class SumoTraffic:
             raise SumoError(f"{self.config}: SUMO could not load it: {_first_line(exc)}") from None
         try:
             self._watch()
+            # Every vType known at the start is turned into its vehicle model now, so that an
+            # impossible parameter stops the run before it starts, naming the vType.
+            for type_id in libsumo.vehicletype.getIDList():
+                self._model(type_id)
         except Exception:
             self.close()
             raise

@@ -239,3 +239,17 @@ def read_log_status(path):
     from cosim.log import read_log
 
     return read_log(path).final_status
+
+
+def test_cli_rejects_a_vtype_with_impossible_parameters_before_the_run(tmp_path):
+    shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
+    (tmp_path / "bad.rou.xml").write_text(
+        '<routes><vType id="lorry" vClass="truck" mass="20000"><param key="cosim.k_v" value="stiff"/></vType>'
+        '<flow id="f" type="lorry" begin="0" end="100" vehsPerHour="100" from="in_e" to="out_e"/></routes>')
+    (tmp_path / "bad.sumocfg").write_text(
+        '<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/></input>'
+        '</configuration>')
+    (tmp_path / "s.toml").write_text(SCENARIO.format(config="bad.sumocfg", end=30.0))
+    run = cosim("run", "s.toml", "--out", "a.mcap", "--quiet", cwd=tmp_path)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "vType lorry: param `cosim.k_v` must be a number" in run.stderr
