@@ -34,6 +34,7 @@ from . import __version__, runner
 from .bridge import BridgeModel, ModalResult, PointLoad
 from .errors import CosimError
 from .log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
+from .traffic import vehicle_of
 from .scenario import Scenario, list_bundled_scenarios, load_scenario
 from .section import SectionProperties
 
@@ -454,8 +455,10 @@ def _vehicle_summary(outcome: runner.RunOutcome, limit: int = 12) -> list[str]:
     ids = scripted or sorted(outcome.on_deck, key=lambda v: -result.contact_force_range.get(v, (0, 0))[1])
     lifted_total = sum(1 for v in outcome.on_deck if result.contact_force_range.get(v, (0.0, 0.0))[0] < 0)
     of = f" of {len(scripted)}" if scripted else ""
+    vehicles = {vehicle_of(c) for c in outcome.on_deck}
+    axles = "" if len(vehicles) == len(outcome.on_deck) else f" ({len(outcome.on_deck)} axles)"
     lines = [
-        f"Vehicles: {len(outcome.on_deck)}{of} on the deck during the run, at most {result.max_on_deck} "
+        f"Vehicles: {len(vehicles)}{of}{axles} on the deck during the run, at most {result.max_on_deck} "
         f"at once, {lifted_total} lifted off; contact force, compression positive"
         + ("" if scripted or len(ids) <= limit else f" (the {limit} heaviest shown)"),
     ]

@@ -31,7 +31,7 @@ import numpy.typing as npt
 
 from .bridge import BridgeModel
 from .simulation import Sensor
-from .traffic import TrafficSource
+from .traffic import TrafficSource, vehicle_of
 
 #: Sensor quantities that have a quasi-static response (and hence a DAF).
 STATIC_QUANTITIES = ("displacement", "bending_moment")
@@ -152,13 +152,20 @@ def quasi_static(
                 contrib = -weight[cols][None, :] * ordinates  # downward weight
                 for s in range(len(sensors)):
                     values[:, s] = np.bincount(rows, weights=contrib[s], minlength=k)
-                max_on = max(max_on, int(on.sum(axis=1).max()))
+                # Vehicles, not contact points: the axles of one vehicle ("id#k") count once, masses add up.
+                owner = np.array([vehicle_of(v) for v in block.ids])
+                names_u, col_owner = np.unique(owner, return_inverse=True)
+                on_vehicle = np.zeros((k, len(names_u)), dtype=bool)
+                on_vehicle[rows, col_owner[cols]] = True
+                max_on = max(max_on, int(on_vehicle.sum(axis=1).max()))
                 present = np.flatnonzero(on.any(axis=0))
+                vehicle_mass = np.bincount(col_owner, weights=mass, minlength=len(names_u))
                 for j in present:
-                    seen.setdefault(block.ids[j], None)
-                j_max = present[int(np.argmax(mass[present]))]
-                if mass[j_max] > heaviest:
-                    heaviest, heaviest_id = float(mass[j_max]), block.ids[j_max]
+                    seen.setdefault(owner[j], None)
+                u = np.unique(col_owner[present])
+                u_max = u[int(np.argmax(vehicle_mass[u]))]
+                if vehicle_mass[u_max] > heaviest:
+                    heaviest, heaviest_id = float(vehicle_mass[u_max]), str(names_u[u_max])
         if len(sensors):
             peak = np.maximum(peak, np.abs(values).max(axis=0))
         keep = steps % output_every == 0

@@ -21,7 +21,7 @@ from .coupling import BlockReport, CoupledSystem
 from .errors import ConfigError
 from .integrator import Scheme, make_basis
 from .roughness import RoadProfile
-from .traffic import TrafficBlock, TrafficSource
+from .traffic import TrafficBlock, TrafficSource, vehicle_of
 
 SENSOR_QUANTITIES = ("displacement", "velocity", "acceleration", "bending_moment")
 
@@ -87,7 +87,7 @@ class SimulationResult:
         steps: time steps taken; wall_time: s.
         sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
         contact_force_range: (min, max) contact force per vehicle while on the deck, N.
-        max_on_deck: most vehicles on the deck at once.
+        max_on_deck: most vehicles on the deck at once (a vehicle's axles count once).
     """
 
     t: npt.NDArray[np.float64]
@@ -183,7 +183,13 @@ class _Extremes:
             self.s_max = np.maximum(self.s_max, report.sensors.max(axis=0))
         if not report.ids:
             return
-        self.max_on_deck = max(self.max_on_deck, int(report.on_deck.sum(axis=1).max()))
+        # Vehicles, not contact points: the axles of one vehicle ("id#k") count once.
+        owners = np.array([vehicle_of(v) for v in report.ids])
+        _, col_owner = np.unique(owners, return_inverse=True)
+        on_vehicle = np.zeros((len(report.on_deck), col_owner.max() + 1), dtype=bool)
+        rows, cols = np.nonzero(report.on_deck)
+        on_vehicle[rows, col_owner[cols]] = True
+        self.max_on_deck = max(self.max_on_deck, int(on_vehicle.sum(axis=1).max()))
         on = report.on_deck.any(axis=0)
         masked_min = np.where(report.on_deck, report.contact_force, np.inf).min(axis=0)
         masked_max = np.where(report.on_deck, report.contact_force, -np.inf).max(axis=0)

@@ -138,6 +138,45 @@ def model_from_parameters(
     )
 
 
+def axles_from_parameters(type_id: str, length: float, params: dict[str, str]) -> tuple[tuple[float, float], ...]:
+    """The vType's axles as (distance behind the front bumper m, share of the load), or one at mid-length.
+
+    ``cosim.axles`` lists the distances (m, space-separated), ``cosim.axle_loads``
+    the shares of the vehicle's weight and suspension (summing to 1).
+
+    Raises:
+        SumoError: the lists do not match, are not numbers, or are not physical.
+    """
+    spacing = params.get(PARAM_PREFIX + "axles", "").split()
+    loads = params.get(PARAM_PREFIX + "axle_loads", "").split()
+    if not spacing and not loads:
+        return ((0.5 * length, 1.0),)
+    try:
+        where = [float(v) for v in spacing]
+        share = [float(v) for v in loads]
+    except ValueError:
+        raise SumoError(f"vType {type_id}: params `{PARAM_PREFIX}axles` and `{PARAM_PREFIX}axle_loads` must be "
+                        "space-separated numbers") from None
+    if len(where) != len(share):
+        raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}axles` has {len(where)} value(s), "
+                        f"`{PARAM_PREFIX}axle_loads` {len(share)}: give one load share per axle")
+    if any(not 0.0 <= d <= length for d in where):
+        raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}axles` must lie on the vehicle, 0 to {length:g} m "
+                        f"behind the front bumper (got {spacing})")
+    if any(not f > 0 for f in share) or abs(sum(share) - 1.0) > 1e-6:
+        raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}axle_loads` must be positive and sum to 1 (got {loads})")
+    return tuple(zip(where, share))
+
+
+def scaled_model(model: VehicleModel, share: float) -> VehicleModel:
+    """The part of ``model`` carried by one axle: masses, stiffnesses and dampings times ``share``."""
+    if isinstance(model, MovingForce):
+        return MovingForce(model.mass * share)
+    from dataclasses import asdict, replace
+
+    return replace(model, **{k: v * share for k, v in asdict(model).items()})
+
+
 class SumoTraffic:
     """Vehicles from a SUMO simulation (through libsumo), as a traffic source for the beam.
 
@@ -183,6 +222,7 @@ class SumoTraffic:
         self.edges: tuple[str, ...] = ()
         self.models: dict[str, VehicleModel] = {}
         self.frames: FrameTraffic | None = None
+        self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
         self.libsumo = None
         self.sumo_steps = 0
         self.teleports = 0
@@ -209,8 +249,10 @@ class SumoTraffic:
             self._watch()
             # Every vType known at the start is turned into its vehicle model now, so that an
             # impossible parameter stops the run before it starts, naming the vType.
+            distributions = _distribution_ids(self.config)
             for type_id in libsumo.vehicletype.getIDList():
-                self._model(type_id)
+                if type_id not in distributions:  # a distribution's id is not a vehicle's type
+                    self._model(type_id)
         except Exception:
             self.close()
             raise
@@ -277,11 +319,19 @@ class SumoTraffic:
         ls = self.libsumo
         vt = ls.vehicletype
         params = {}
-        for key in ("model", "m_w", "k_v", "c_v", "k_t", "c_t"):
+        for key in ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads"):
             value = vt.getParameter(type_id, PARAM_PREFIX + key)
             if value != "":
                 params[PARAM_PREFIX + key] = value
-        self.models[type_id] = model_from_parameters(type_id, vt.getMass(type_id), vt.getVehicleClass(type_id), params)
+        whole = model_from_parameters(type_id, vt.getMass(type_id), vt.getVehicleClass(type_id), params)
+        axles = axles_from_parameters(type_id, vt.getLength(type_id), params)
+        self._axles[type_id] = axles
+        if len(axles) == 1:
+            self.models[type_id] = whole
+        else:  # one vehicle model per axle: "type#k" carries axle k's share
+            for k, (_, share) in enumerate(axles):
+                self.models[f"{type_id}#{k}"] = scaled_model(whole, share)
+            self.models[type_id] = whole
 
     def advance(self) -> Frame:
         """One SUMO step; returns the frame of vehicles near the bridge."""
@@ -313,14 +363,24 @@ class SumoTraffic:
         ang = np.fromiter((r[tc.VAR_ANGLE] for r in rows), dtype=float, count=n)
         spd = np.fromiter((r[tc.VAR_SPEED] for r in rows), dtype=float, count=n)
         acc = np.fromiter((r[tc.VAR_ACCELERATION] for r in rows), dtype=float, count=n)
-        half = 0.5 * np.fromiter((r[tc.VAR_LENGTH] for r in rows), dtype=float, count=n)
+        length = np.fromiter((r[tc.VAR_LENGTH] for r in rows), dtype=float, count=n)
         types = [r[tc.VAR_TYPE] for r in rows]
         for typ in types:
             if typ not in self.models:
                 self._model(typ)
+        # One contact point per axle (a vType without axles: one at mid-length), behind the bumper.
+        back = np.array([d if len(self._axles[t]) > 1 else 0.5 * L
+                         for t, L in zip(types, length) for d, _ in self._axles[t]], dtype=float)
+        owner = np.array([i for i, t in enumerate(types) for _ in self._axles[t]], dtype=np.int64)
+        if len(owner) != n:
+            ids = [vid if len(self._axles[t]) == 1 else f"{vid}#{k}"
+                   for vid, t in zip(ids, types) for k in range(len(self._axles[t]))]
+            types = [t if len(self._axles[t]) == 1 else f"{t}#{k}"
+                     for t in types for k in range(len(self._axles[t]))]
+            pos, ang, spd, acc = pos[owner], ang[owner], spd[owner], acc[owner]
         heading = np.radians(ang)
         hx, hy = np.sin(heading), np.cos(heading)  # SUMO angle: 0 = north, clockwise
-        x, y = self.axis.project(pos[:, 0] - half * hx, pos[:, 1] - half * hy)
+        x, y = self.axis.project(pos[:, 0] - back * hx, pos[:, 1] - back * hy)
         e, _ = self.axis._frame
         along = hx * e[0] + hy * e[1]
         keep = np.abs(y) <= self.half_width
@@ -345,6 +405,29 @@ class SumoTraffic:
         out = self.frames.block(times)
         self.frames.forget_before(float(times[-1]))
         return out
+
+
+def _distribution_ids(config: Path) -> set[str]:
+    """Ids of the vTypeDistributions in the route and additional files a SUMO config names (parsed as XML)."""
+    import xml.etree.ElementTree as ET
+
+    found: set[str] = set()
+    try:
+        root = ET.parse(config).getroot()
+    except (ET.ParseError, OSError):
+        return found
+    for tag in ("route-files", "additional-files"):
+        for element in root.iter(tag):
+            for name in element.get("value", "").split(","):
+                path = config.parent / name.strip()
+                if not name.strip() or not path.is_file():
+                    continue
+                try:
+                    for dist in ET.parse(path).getroot().iter("vTypeDistribution"):
+                        found.add(dist.get("id", ""))
+                except (ET.ParseError, OSError):
+                    continue
+    return found
 
 
 def _first_line(exc: BaseException) -> str:

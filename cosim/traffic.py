@@ -19,6 +19,14 @@ from .errors import ConfigError
 from .vehicles import VehicleModel
 
 
+AXLE_SEPARATOR = "#"
+
+
+def vehicle_of(contact_id: str) -> str:
+    """The vehicle a contact point belongs to: ``"truck7#2"`` (axle 2 of truck7) -> ``"truck7"``."""
+    return contact_id.split(AXLE_SEPARATOR, 1)[0]
+
+
 @dataclass(frozen=True)
 class TrafficFrame:
     """Vehicles present at one instant (parallel arrays, one entry per vehicle).

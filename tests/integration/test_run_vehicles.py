@@ -84,7 +84,7 @@ def test_default_run_is_ten_minutes_of_sumo_traffic(tmp_path: Path) -> None:
     out = result.stdout
     assert "Scenario: paper-bridge-traffic" in out and "Traffic: SUMO" in out and "medium demand" in out
     assert "Road: ISO 8608 class A, seed 1" in out
-    on_deck = int(out.split("Vehicles: ")[1].split(" on the deck")[0])
+    on_deck = int(out.split("Vehicles: ")[1].split(" ")[0])
     assert on_deck > 100  # 10 min at 500 vehicles per hour and direction
     log = only_log(tmp_path / "runs")
     info = cosim_cli("info", str(log), cwd=tmp_path).stdout
