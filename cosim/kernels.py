@@ -189,6 +189,19 @@ def vehicle_update(kind, m_v, m_w, k_v, c_v, k_t, c_t, weight, vstate, speed, ac
         out_weighted[i] = -weight[i] + susp + tyre if kind[i] != MOVING_FORCE else -weight[i]
 
 
+@njit(cache=True)
+def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):
+    """d, v, a of the new step from the predictors and the new acceleration; False if it is not finite."""
+    finite = True
+    for j in range(d.shape[0]):
+        d[j] = d_star[j] + b2 * acc[j]
+        v[j] = v_star[j] + g1 * acc[j]
+        a[j] = acc[j]
+        if not np.isfinite(acc[j]):
+            finite = False
+    return finite
+
+
 # ----------------------------------------------------------- direct basis
 @njit(cache=True)
 def csr_matvec_add(indptr, indices, data, x, out, scale):
@@ -313,14 +326,7 @@ def direct_block(cb, k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat, ray_a, ray_b, ain
             counters[2] += 1
             for j in range(n):
                 z_b[j] -= corr[j]
-        finite = True
-        for j in range(n):
-            d[j] = d_star[j] + b2 * z_b[j]
-            v[j] = v_star[j] + g1 * z_b[j]
-            a[j] = z_b[j]
-            if not np.isfinite(z_b[j]):
-                finite = False
-        if not finite:
+        if not _newmark_update(d, v, a, d_star, v_star, z_b, b2, g1):
             counters[3] = step + 1
             return
         for i in range(q):
@@ -472,14 +478,7 @@ def modal_block(phi, c_diag, k_diag, a_inv,
                     corr += n0[k, j] * sol[k]
                 z_b[j] -= a_inv[j] * corr
         counters[2] += 1
-        finite = True
-        for j in range(m):
-            d[j] = d_star[j] + b2 * z_b[j]
-            v[j] = v_star[j] + g1 * z_b[j]
-            a[j] = z_b[j]
-            if not np.isfinite(z_b[j]):
-                finite = False
-        if not finite:
+        if not _newmark_update(d, v, a, d_star, v_star, z_b, b2, g1):
             counters[3] = step + 1
             return
         for i in range(q):
