@@ -741,7 +741,8 @@ def build_parser() -> argparse.ArgumentParser:
             """\
             Co-simulation of road traffic and bridge vibration: a 7-DOF
             Timoshenko-Vlasov beam model of the bridge (shear deformation,
-            rotary inertia, uniform and non-uniform torsion) driven by vehicles.
+            rotary inertia, uniform and non-uniform torsion) driven by scripted
+            vehicles or by SUMO traffic, every run logged to MCAP.
             Scenarios are TOML files (see docs/scenario.md); SI units throughout."""
         ),
         epilog=textwrap.dedent(
