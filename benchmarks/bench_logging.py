@@ -10,9 +10,9 @@ Run on demand (not a test)::
    ``--minutes`` of simulated time logged at 100 Hz (every 2nd step). Timed
    side by side in interleaved rounds, best of ``--reps``:
 
-   - no log: :func:`cosim.simulation.simulate` with ``collect=False`` (the
+   - no log: :func:`cosim.core.simulation.simulate` with ``collect=False`` (the
      time stepping alone, constant memory);
-   - log: :func:`cosim.runner.run_logged` (what ``cosim run`` does after the
+   - log: :func:`cosim.run.logged.run_logged` (what ``cosim run`` does after the
      bridge is built): the same time stepping plus the whole log (attachments,
      modes, sensors, vehicles, events, status; zstd chunks; finished file).
 
@@ -43,9 +43,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
 
-from cosim.runner import run_logged  # noqa: E402
-from cosim.scenario import load_scenario, parse_scenario  # noqa: E402
-from cosim.simulation import simulate  # noqa: E402
+from cosim.core.simulation import simulate  # noqa: E402
+from cosim.run.logged import run_logged  # noqa: E402
+from cosim.run.scenario import load_scenario, parse_scenario  # noqa: E402
 
 SPEED = 0.06  # m/s: 40 m take 667 s
 VEHICLES = 8

@@ -7,7 +7,7 @@ Run on demand (not a test)::
 What is timed, in microseconds of wall time (``time.perf_counter``) per time
 step, BLAS pinned to one thread:
 
-1. cosim's compiled step (:meth:`cosim.coupling.CoupledSystem.advance` on a
+1. cosim's compiled step (:meth:`cosim.core.coupling.CoupledSystem.advance` on a
    block of steps) on the paper bridge (40 m, dt = 5 ms) for the ``direct``
    basis and the ``modal`` basis (30 modes; every mode up to 50 Hz), with 0-64
    quarter-cars, the moving-force model, and 20-160 elements per span.
@@ -29,7 +29,7 @@ the same chances of a quiet moment, which keeps the ratios honest.
 The fleet: vehicles spread along both lanes (y = -3.325 m drives along +x,
 y = +3.325 m along -x), at 1 m/s so that every vehicle stays on the deck for
 the whole timed block. The traffic arrays are built directly as a
-:class:`cosim.traffic.TrafficBlock`; a warm-up call compiles (or loads) the
+:class:`cosim.core.traffic.TrafficBlock`; a warm-up call compiles (or loads) the
 numba kernels before anything is timed.
 """
 from __future__ import annotations
@@ -61,13 +61,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 
 import numba  # noqa: E402
 
-from cosim import kernels  # noqa: E402
-from cosim.bridge import BridgeModel, ExplicitDamping, build_bridge  # noqa: E402
-from cosim.coupling import CoupledSystem  # noqa: E402
-from cosim.integrator import Scheme, make_basis  # noqa: E402
-from cosim.scenario import load_scenario  # noqa: E402
-from cosim.traffic import TrafficBlock  # noqa: E402
-from cosim.vehicles import MovingForce, QuarterCar, VehicleModel  # noqa: E402
+from cosim.core import kernels  # noqa: E402
+from cosim.core.bridge import BridgeModel, ExplicitDamping, build_bridge  # noqa: E402
+from cosim.core.coupling import CoupledSystem  # noqa: E402
+from cosim.core.integrator import Scheme, make_basis  # noqa: E402
+from cosim.core.traffic import TrafficBlock  # noqa: E402
+from cosim.core.vehicles import MovingForce, QuarterCar, VehicleModel  # noqa: E402
+from cosim.run.scenario import load_scenario  # noqa: E402
 
 DT = 0.005  # s, the paper's step
 SPEED = 1.0  # m/s: slow, so the fleet stays on the deck for the whole block

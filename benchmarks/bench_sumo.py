@@ -27,10 +27,10 @@ MODES = ("sumo", "direct", "direct+log", "modal", "modal+log")
 WORKER = r"""
 import json, sys, tempfile, time
 from pathlib import Path
-from cosim.scenario import load_scenario
-from cosim.simulation import Sensor, SolverSettings, simulate
-from cosim.sumo import BridgeAxis, SumoTraffic, bundled_networks
-from cosim.log import BlockLogger, LogRecorder, TrafficLogger
+from cosim.run.scenario import load_scenario
+from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks
+from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 
 level, mode, minutes = sys.argv[1], sys.argv[2], float(sys.argv[3])
 duration = 60.0 * minutes
@@ -41,7 +41,7 @@ sensors = [Sensor("n1", 20, 0.0), Sensor("n2", 20, 6.655), Sensor("n3", 20, 3.32
            Sensor("a3", 20, 3.325, "acceleration")]
 basis = mode.split("+")[0]
 # Compile (or load) the kernels outside the timed part.
-from cosim.traffic import ScriptedTraffic
+from cosim.core.traffic import ScriptedTraffic
 simulate(bridge, ScriptedTraffic((), 40.0), 0.01, SolverSettings(dt=0.005, basis=basis if basis != "sumo" else "direct", modes=30), sensors)
 started = time.perf_counter()
 vehicles = max_on = 0

@@ -1,6 +1,6 @@
 """``python -m cosim``: the same as the ``cosim`` command."""
 import sys
 
-from .cli import main
+from cosim.cli import main
 
 sys.exit(main())

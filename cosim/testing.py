@@ -48,10 +48,10 @@ from typing import Any, Iterable, Mapping, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from .bridge import BridgeModel
-from .errors import ConfigError
-from .quasistatic import QuasiStaticResult, quasi_static
-from .scenario import Scenario, load_scenario, parse_scenario
+from cosim.core.bridge import BridgeModel
+from cosim.core.quasistatic import QuasiStaticResult, quasi_static
+from cosim.errors import ConfigError
+from cosim.run.scenario import Scenario, load_scenario, parse_scenario
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -127,7 +127,7 @@ def _base(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None
 
 def scenario(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = None,
              **overrides: Any) -> Scenario:
-    """A validated :class:`cosim.scenario.Scenario` from a base and overrides.
+    """A validated :class:`cosim.run.scenario.Scenario` from a base and overrides.
 
     Args:
         base: a scenario file path, a bundled scenario name, TOML text, a dict of
@@ -142,7 +142,7 @@ def scenario(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None 
         return base
     data, source, folder = _base(base)
     data = _merge(data, overrides)
-    from .runner import toml_dumps
+    from cosim.run.logged import toml_dumps
 
     try:
         text = toml_dumps(data)
@@ -301,7 +301,7 @@ class Results:
 
     def _traffic(self) -> Any:
         if self.log_path is not None:
-            from .log import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, read_log, traffic_from_log
+            from cosim.log.writer import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, read_log, traffic_from_log
 
             traffic_cfg = self.scenario.traffic
             if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)
@@ -319,7 +319,7 @@ class Results:
 
     def daf(self, name: str) -> float:
         """Dynamic amplification factor: :meth:`peak` over :meth:`static_peak` (NaN without a static value)."""
-        from .quasistatic import daf as _daf
+        from cosim.core.quasistatic import daf as _daf
 
         return _daf(self.peak(name), self.static_peak(name))
 
@@ -329,8 +329,8 @@ class Results:
 
 
 def _vehicles_from_log(path: Path) -> dict[str, dict[str, npt.NDArray[np.float64]]]:
-    from .log import TOPIC_VEHICLES
-    from .runner import iter_messages
+    from cosim.log.writer import TOPIC_VEHICLES
+    from cosim.run.logged import iter_messages
 
     columns = ("t", "x", "y", "speed", "acceleration", "contact_force", "body_displacement", "body_acceleration")
     rows: dict[str, dict[str, list[float]]] = {}
@@ -364,7 +364,7 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
 
 
 def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel) -> Results:
-    from .runner import sensor_series
+    from cosim.run.logged import sensor_series
 
     result = outcome.result
     t, series = sensor_series(outcome.log_path, [s.name for s in sc.sensors])
@@ -402,7 +402,7 @@ def run(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = Non
     model = bridge_model if bridge_model is not None else sc.build_bridge()
     if log is None and not _has_traffic(sc):
         return _from_simulation(sc, sc.simulate(bridge=model), model)
-    from .runner import run_logged
+    from cosim.run.logged import run_logged
 
     if log is not None:
         outcome = run_logged(sc, Path(log), force=True, bridge=model)
@@ -471,7 +471,7 @@ def dominant_frequency(t: npt.ArrayLike, values: npt.ArrayLike, band: tuple[floa
 
 
 def _unit(result: Results, name: str) -> tuple[str, float]:
-    from .runner import DISPLAY_UNITS
+    from cosim.run.logged import DISPLAY_UNITS
 
     return DISPLAY_UNITS.get(result.quantities.get(name, ""), ("SI", 1.0))
 
@@ -520,7 +520,7 @@ def assert_matches_log(result: Results, log_path: str | os.PathLike[str], rtol: 
     stored samples (the stored log is interpolated at the result's times when
     its times differ). Every channel compared must be in both.
     """
-    from .runner import open_log, sensor_series
+    from cosim.run.logged import open_log, sensor_series
 
     stored_names = open_log(log_path).sensor_names
     names = list(sensors) if sensors is not None else list(result.channels)
@@ -618,7 +618,7 @@ if pytest is not None:
                 if result.log_path is not None and Path(result.log_path).is_file():
                     shutil.copyfile(result.log_path, path)
                 else:
-                    from .runner import run_logged
+                    from cosim.run.logged import run_logged
 
                     run_logged(result.scenario, path, force=True, bridge=result.bridge)
                 return path

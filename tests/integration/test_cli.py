@@ -25,8 +25,6 @@ PAPER_STATIC_TEXT = _without_vehicles(PAPER_TEXT)
 
 from _cli import cosim_cli  # noqa: E402
 
-
-
 # --------------------------------------------------------------------------- help
 
 

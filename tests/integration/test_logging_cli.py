@@ -21,13 +21,12 @@ import jsonschema
 import numpy as np
 import pytest
 import tomllib
+from _cli import TWO_CARS, cli_env, cosim_cli
 
 import cosim
-from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
-from cosim.runner import toml_dumps
-from cosim.scenario import load_scenario
-
-from _cli import TWO_CARS, cli_env, cosim_cli
+from cosim.log.writer import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
+from cosim.run.logged import toml_dumps
+from cosim.run.scenario import load_scenario
 
 # A 20 m span with explicit constants (fast to build): a quarter-car along +x
 # and a golden car along -x on a class H road (the light wheels lift off),
@@ -335,7 +334,7 @@ def test_the_bulk_message_path_writes_the_same_bytes_as_mcap() -> None:
 
     from mcap.writer import CompressionType
 
-    from cosim.log import _BulkWriter
+    from cosim.log.writer import _BulkWriter
 
     rng = random.Random(1)
     datas = [bytes(rng.randrange(256) for _ in range(rng.randrange(1, 2000))) for _ in range(1200)]

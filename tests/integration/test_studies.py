@@ -25,11 +25,11 @@ import pytest
 
 import cosim
 from cosim.errors import ConfigError
-from cosim.log import file_is_complete
-from cosim.runner import compare_sensors, run_logged
-from cosim.scenario import load_scenario
-from cosim.studies import load_study, parse_study, run_study, summary_text
-from cosim.sumo import bundled_networks
+from cosim.log.writer import file_is_complete
+from cosim.run.logged import compare_sensors, run_logged
+from cosim.run.scenario import load_scenario
+from cosim.study.study import load_study, parse_study, run_study, summary_text
+from cosim.sumo.adapter import bundled_networks
 
 REPO = Path(cosim.__file__).resolve().parents[1]
 
@@ -226,7 +226,7 @@ def test_a_study_on_a_separately_started_scheduler(on_two_workers, tmp_path):
 
 RUN_STUDY = """\
 import sys
-from cosim.studies import load_study, run_study
+from cosim.study.study import load_study, run_study
 if __name__ == "__main__":
     run_study(load_study(sys.argv[1], output=sys.argv[2]), workers=1, plots=False)
 """
@@ -328,7 +328,7 @@ def test_a_broken_demand_file_fails_its_runs_only(tmp_path):
 
 
 def test_sweeping_the_speed_limit_slows_the_traffic(tmp_path):
-    from cosim.log import TOPIC_TRAFFIC, read_log
+    from cosim.log.writer import TOPIC_TRAFFIC, read_log
 
     study_path = _write_study(tmp_path, STUDY.replace(
         "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "speed_limit = [10.0, 25.0]\nseeds = [3]"))

@@ -7,12 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cosim.bridge import PointLoad
+from cosim.core.bridge import PointLoad
+from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.vehicles import QuarterCar
 from cosim.errors import SumoError
-from cosim.scenario import load_scenario
-from cosim.simulation import Sensor, SolverSettings, simulate
-from cosim.sumo import BridgeAxis, SumoTraffic, bundled_networks, model_from_parameters
-from cosim.vehicles import QuarterCar
+from cosim.run.scenario import load_scenario
+from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks, model_from_parameters
 
 AXIS = BridgeAxis((0.0, 0.0), (40.0, 0.0))
 G = 9.81
@@ -141,7 +141,7 @@ def test_vtype_parameters_become_quarter_cars():
 
 
 def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, tmp_path):
-    from cosim.log import TOPIC_SENSORS, BlockLogger, LogRecorder, TrafficLogger, read_log, traffic_from_log
+    from cosim.log.writer import TOPIC_SENSORS, BlockLogger, LogRecorder, TrafficLogger, read_log, traffic_from_log
 
     sensors = [Sensor("mid", 20.0, 0.0), Sensor("acc", 20.0, 3.0, "acceleration")]
     names = [s.name for s in sensors]
@@ -165,7 +165,7 @@ def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, t
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 
-from cosim.scenario import SUMO_LEVELS  # noqa: E402
+from cosim.run.scenario import SUMO_LEVELS  # noqa: E402
 
 SCENARIO = """
 name = "sumo-cli"
@@ -240,7 +240,7 @@ def test_cli_reports_a_broken_sumo_config_and_finishes_the_log(tmp_path):
 
 
 def read_log_status(path):
-    from cosim.log import read_log
+    from cosim.log.writer import read_log
 
     return read_log(path).final_status
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-import cosim.validation as validation
+import cosim.validation.cases as validation
 from cosim.errors import CosimError
-from cosim.validation import ValidationReport, run_validation, study_names
+from cosim.validation.cases import ValidationReport, run_validation, study_names
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 MIN_PNG_BYTES = 10_000  # a plot with axes, curves and a legend; an empty canvas is ~3 kB
@@ -110,7 +110,7 @@ def test_unknown_study_is_a_cosim_error(tmp_path: Path) -> None:
 
 
 def test_importing_the_validation_module_does_not_import_matplotlib() -> None:
-    code = "import sys, cosim.validation, cosim.references; print('matplotlib' in sys.modules)"
+    code = "import sys, cosim.validation.cases, cosim.validation.references; print('matplotlib' in sys.modules)"
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "False"

@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.bridge import ExplicitDamping, PointLoad, RayleighDamping, build_bridge, support_dofs
+from cosim.core.bridge import ExplicitDamping, PointLoad, RayleighDamping, build_bridge, support_dofs
+from cosim.core.section import Material, SectionProperties
 from cosim.errors import ConfigError, ModelError
-from cosim.section import Material, SectionProperties
 
 MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 SEC = SectionProperties(

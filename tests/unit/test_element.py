@@ -4,8 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.element import DOF_INDEX, element_matrices, field_matrix, shear_parameters
-from cosim.section import Material, SectionProperties
+from cosim.core.element import DOF_INDEX, element_matrices, field_matrix, shear_parameters
+from cosim.core.section import Material, SectionProperties
 
 MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 # A deliberately general section: S off C in both directions and I_yz != 0.

@@ -7,9 +7,13 @@ import jsonschema
 import numpy as np
 import pytest
 
-from cosim.bridge import build_bridge
+from cosim.core.bridge import build_bridge
+from cosim.core.section import Material, SectionProperties
+from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+from cosim.core.vehicles import QuarterCar
 from cosim.errors import LogError
-from cosim.log import (
+from cosim.log.writer import (
     TOPIC_EVENTS,
     TOPIC_SENSORS,
     TOPIC_STATUS,
@@ -19,10 +23,6 @@ from cosim.log import (
     file_is_complete,
     read_log,
 )
-from cosim.section import Material, SectionProperties
-from cosim.simulation import Sensor, SolverSettings, simulate
-from cosim.traffic import ScriptedTraffic, ScriptedVehicle
-from cosim.vehicles import QuarterCar
 
 MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_s=0.0, z_s=0.0,

@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.bridge import PointLoad
-from cosim.quasistatic import daf, influence, influence_vectors, quasi_static
-from cosim.simulation import Sensor, SolverSettings, simulate
+from cosim.core.bridge import PointLoad
+from cosim.core.quasistatic import daf, influence, influence_vectors, quasi_static
+from cosim.core.simulation import Sensor, SolverSettings, simulate
 from cosim.testing import bridge as bridge_table
 from cosim.testing import moving_force, scenario, sensor
 

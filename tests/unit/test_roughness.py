@@ -4,8 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.errors import ConfigError
-from cosim.roughness import (
+from cosim.core.roughness import (
     ISO_CLASSES,
     N0,
     averaged_psd,
@@ -14,6 +13,7 @@ from cosim.roughness import (
     iso8608_profile,
     profile_from_csv,
 )
+from cosim.errors import ConfigError
 
 
 def test_class_values_are_the_geometric_means_of_their_bands():

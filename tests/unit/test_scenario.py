@@ -9,7 +9,7 @@ import pytest
 from pydantic import ValidationError
 
 from cosim.errors import ConfigError
-from cosim.scenario import (
+from cosim.run.scenario import (
     Scenario,
     list_bundled_scenarios,
     load_scenario,
@@ -726,7 +726,7 @@ speed = 22.0
 
 
 def test_every_vehicle_model_loads_and_builds(tmp_path: Path) -> None:
-    from cosim.vehicles import MovingForce, QuarterCar, TyreQuarterCar
+    from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar
 
     scenario = load_scenario(write(tmp_path, VEHICLES_TEXT, "cars.toml"))
     assert [v.id for v in scenario.vehicles] == ["V1", "qc", "V3", "V4"]  # default ids by position
@@ -861,7 +861,7 @@ def test_output_defaults_log_path_and_rate(tmp_path: Path) -> None:
 
 
 def test_sensors_core_and_solver_settings() -> None:
-    from cosim.simulation import Sensor, SolverSettings
+    from cosim.core.simulation import Sensor, SolverSettings
 
     scenario = parse_scenario(CONSTANTS_TEXT + '[solver]\ndt = 0.01\nscheme = "hht"\nhht_alpha = -0.1\ngravity = 9.8\n')
     assert scenario.sensors_core() == [Sensor(name="mid", x=5.0, y=-3.0, quantity="displacement")]

@@ -9,15 +9,15 @@ import math
 
 import pytest
 
-from cosim import section
-from cosim.errors import ConfigError, ModelError
-from cosim.section import (
+from cosim.core import section
+from cosim.core.section import (
     Plate,
     SectionProperties,
     section_from_constants,
     section_from_plates,
     thin_walled_properties,
 )
+from cosim.errors import ConfigError, ModelError
 
 # Exact integrals of a polygon: only round-off and the FE quadrature remain.
 EXACT_REL = 1e-6

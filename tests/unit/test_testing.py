@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from cosim import testing as ct
-from cosim.bridge import PointLoad
+from cosim.core.bridge import PointLoad
 from cosim.errors import ConfigError
 
 G = 9.81

@@ -4,13 +4,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.bridge import build_bridge
+from cosim.core.bridge import build_bridge
+from cosim.core.roughness import iso8608_profile
+from cosim.core.section import Material, SectionProperties
+from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar
 from cosim.errors import ConfigError
-from cosim.roughness import iso8608_profile
-from cosim.section import Material, SectionProperties
-from cosim.simulation import Sensor, SolverSettings, simulate
-from cosim.traffic import ScriptedTraffic, ScriptedVehicle
-from cosim.vehicles import MovingForce, QuarterCar, TyreQuarterCar
 
 MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_s=0.0, z_s=0.0,

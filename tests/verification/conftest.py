@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import pytest
 
-from cosim.scenario import load_scenario
-from cosim.traffic import ScriptedTraffic, ScriptedVehicle
-from cosim.validation import PAPER_LANE_Y, PAPER_QC1, PAPER_QC2, PAPER_QC2_ENTRY, PAPER_SPEED
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+from cosim.run.scenario import load_scenario
+from cosim.validation.cases import PAPER_LANE_Y, PAPER_QC1, PAPER_QC2, PAPER_QC2_ENTRY, PAPER_SPEED
 
 
 @pytest.fixture(scope="session")

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _beams import STEEL, doubly_symmetric, monosymmetric, rectangle
 
-from cosim.bridge import PointLoad, build_bridge
-from cosim.element import DOF_INDEX
-from cosim.references import (
+from cosim.core.bridge import PointLoad, build_bridge
+from cosim.core.element import DOF_INDEX
+from cosim.validation.references import (
     cantilever_tip_load_deflection,
     euler_bernoulli_ss_frequency_hz,
     lateral_torsional_frequencies_hz,
@@ -18,8 +19,6 @@ from cosim.references import (
     timoshenko_ss_frequency_hz,
     torsional_frequencies_hz,
 )
-
-from _beams import STEEL, doubly_symmetric, monosymmetric, rectangle
 
 # Tolerances (relative unless stated).
 NODAL_EXACT = 1e-9  # locking-free Timoshenko element: exact at the nodes for point loads

@@ -1,19 +1,17 @@
 """Vehicle-bridge interaction against closed forms and independent solutions (DESIGN.md section 8)."""
 from __future__ import annotations
 
-
 import numpy as np
 import pytest
-
-from cosim.bridge import ExplicitDamping, PointLoad, build_bridge
-from cosim.coupling import CoupledSystem
-from cosim.integrator import Scheme, make_basis
-from cosim.references import YANG_YAU, fryba_midspan_deflection, sprung_mass_modal_solution, yang_yau_case
-from cosim.simulation import Sensor, SolverSettings, simulate
-from cosim.traffic import ScriptedTraffic, ScriptedVehicle, TrafficFrame
-from cosim.vehicles import MovingForce, QuarterCar, TyreQuarterCar
-
 from _beams import STEEL, rectangle
+
+from cosim.core.bridge import ExplicitDamping, PointLoad, build_bridge
+from cosim.core.coupling import CoupledSystem
+from cosim.core.integrator import Scheme, make_basis
+from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle, TrafficFrame
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar
+from cosim.validation.references import YANG_YAU, fryba_midspan_deflection, sprung_mass_modal_solution, yang_yau_case
 
 FRYBA_TOL = 0.01  # of the peak, issue 3
 SPRUNG_TOL = 0.02  # of the peak, issue 3

@@ -41,10 +41,12 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-from . import __version__
-from .bridge import BridgeModel, ModalResult
-from .errors import ConfigError, CosimError, LogError, ModelError, SumoError
-from .log import (
+from cosim import __version__
+from cosim.core.bridge import BridgeModel, ModalResult
+from cosim.core.section import SectionProperties
+from cosim.core.simulation import SimulationResult, simulate
+from cosim.errors import ConfigError, CosimError, LogError, ModelError, SumoError
+from cosim.log.writer import (
     EVENTS_SCHEMA,
     PROFILE,
     STATUS_SCHEMA,
@@ -61,9 +63,8 @@ from .log import (
     read_log,
     traffic_from_log,
 )
+
 from .scenario import Scenario, parse_scenario
-from .section import SectionProperties
-from .simulation import SimulationResult, simulate
 
 MAGIC = b"\x89MCAP0\r\n"
 SCENARIO_ATTACHMENT = "scenario.toml"

@@ -28,19 +28,19 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, Iterable, Iterator
 
+import numpy as np
+import orjson
 from mcap.exceptions import McapError
 from mcap.opcode import Opcode
 from mcap.reader import make_reader
-from mcap.stream_reader import StreamReader
 from mcap.records import Attachment, Channel, Footer, Header, Message, MessageIndex, Metadata
+from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
-import numpy as np
-import orjson
 
-from . import __version__
-from .errors import ConfigError, LogError
-from .traffic import Frame, FrameTraffic
-from .vehicles import model_from_dict, model_to_dict
+from cosim import __version__
+from cosim.core.traffic import Frame, FrameTraffic
+from cosim.core.vehicles import model_from_dict, model_to_dict
+from cosim.errors import ConfigError, LogError
 
 PROFILE = "cosim"
 TOPIC_SENSORS = "/cosim/sensors"
@@ -475,7 +475,7 @@ class _PacedTraffic:
 
 
 class BlockLogger:
-    """Observer of :func:`cosim.simulation.simulate` that streams every block into a :class:`LogRecorder`.
+    """Observer of :func:`cosim.core.simulation.simulate` that streams every block into a :class:`LogRecorder`.
 
     Sensor samples and vehicles on the deck at the logging rate (the
     simulation's ``output_every``); traffic events (entered/left the deck,
@@ -521,7 +521,7 @@ class BlockLogger:
     def paced(self, traffic: Any) -> "_PacedTraffic":
         """``traffic``, wrapped so that the writer thread knows when the solver starts its next block.
 
-        Pass the wrapper to :func:`cosim.simulation.simulate` instead of
+        Pass the wrapper to :func:`cosim.core.simulation.simulate` instead of
         ``traffic``: the thread then encodes a block while the compiled solver
         (which releases the GIL) computes the next one, instead of holding the
         GIL while the solver thread needs it between two blocks. It costs

@@ -1,6 +1,6 @@
 """The bridge: a continuous beam of 7-DOF elements with supports, damping, modes and statics.
 
-Global DOF ``7 * node + k`` with ``k`` in :data:`cosim.element.DOF_NAMES` order;
+Global DOF ``7 * node + k`` with ``k`` in :data:`cosim.core.element.DOF_NAMES` order;
 nodes are numbered from the first abutment (x = 0) along +x.
 
 Sign convention used everywhere (tested): the vertical displacement of a deck
@@ -20,6 +20,8 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from cosim.errors import ConfigError, ModelError
+
 from .element import (
     DOF_INDEX,
     DOF_NAMES,
@@ -33,7 +35,6 @@ from .element import (
     shape_coefficients,
     shear_parameters,
 )
-from .errors import ConfigError, ModelError
 from .section import Material, SectionProperties
 
 __all__ = [

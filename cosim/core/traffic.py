@@ -15,9 +15,9 @@ from typing import Protocol
 import numpy as np
 import numpy.typing as npt
 
-from .errors import ConfigError
-from .vehicles import VehicleModel
+from cosim.errors import ConfigError
 
+from .vehicles import VehicleModel
 
 AXLE_SEPARATOR = "#"
 

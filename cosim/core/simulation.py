@@ -1,6 +1,6 @@
 """Run a vehicle-bridge simulation and collect named results.
 
-:func:`simulate` drives a :class:`~cosim.coupling.CoupledSystem` with any
+:func:`simulate` drives a :class:`~cosim.core.coupling.CoupledSystem` with any
 traffic source and samples the sensors (deck displacement, velocity,
 acceleration including the twist contribution, bending moment) and every
 vehicle (contact force, body displacement and acceleration).
@@ -16,9 +16,10 @@ from typing import Callable, Protocol, Sequence
 import numpy as np
 import numpy.typing as npt
 
+from cosim.errors import ConfigError
+
 from .bridge import BridgeModel
 from .coupling import BlockReport, CoupledSystem
-from .errors import ConfigError
 from .integrator import Scheme, make_basis
 from .roughness import RoadProfile
 from .traffic import TrafficBlock, TrafficSource, vehicle_of

@@ -10,7 +10,7 @@ reference); :class:`ModalBasis` keeps a truncated set of mass-normalised modes
 (fast). Both expose the same operations in their reduced coordinates, and
 both factorise the effective matrix ``A = M + (1 + alpha)(gamma dt C + beta
 dt^2 K)`` exactly once; vehicles enter the step as low-rank updates
-(:mod:`cosim.coupling`). ``n_factorizations`` and ``n_solves`` count the work.
+(:mod:`cosim.core.coupling`). ``n_factorizations`` and ``n_solves`` count the work.
 """
 from __future__ import annotations
 
@@ -20,8 +20,9 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
+from cosim.errors import ConfigError
+
 from .bridge import BridgeModel
-from .errors import ConfigError
 
 
 @dataclass(frozen=True)

@@ -2,10 +2,10 @@
 
 :func:`run_validation` runs every case of DESIGN.md section 8 -- the paper's
 40 m double-tee bridge (``shared/cases/paper-double-tee.md``) and the closed-form
-and independent references of :mod:`cosim.references` -- and writes
+and independent references of :mod:`cosim.validation.references` -- and writes
 ``report.md`` and one PNG per plot into a directory::
 
-    from cosim.validation import run_validation
+    from cosim.validation.cases import run_validation
 
     report = run_validation("validation-out", quick=True)
     print(report.all_passed, report.report_path)
@@ -31,10 +31,10 @@ from typing import Callable, Sequence
 import numpy as np
 import numpy.typing as npt
 
-from . import __version__
-from .bridge import BridgeModel, ExplicitDamping, PointLoad, build_bridge
-from .element import DOF_INDEX, NODE_DOFS
-from .errors import CosimError
+from cosim import __version__
+from cosim.core.bridge import BridgeModel, ExplicitDamping, PointLoad, build_bridge
+from cosim.core.element import DOF_INDEX, NODE_DOFS
+from cosim.errors import CosimError
 from .references import (
     STEEL,
     YANG_YAU,
@@ -52,8 +52,8 @@ from .references import (
     timoshenko_ss_frequency_hz,
     torsional_frequencies_hz,
 )
-from .section import SectionProperties
-from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.section import SectionProperties
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 
 __all__ = ["CaseResult", "ValidationReport", "ValidationSettings", "run_validation", "study_names"]
 
@@ -369,7 +369,7 @@ def _orders(h: npt.ArrayLike, errors: npt.ArrayLike) -> npt.NDArray[np.float64]:
 
 
 def _paper_traffic(first: VehicleModel, second: VehicleModel, length: float):  # noqa: ANN202
-    from .traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 
     return ScriptedTraffic((
         ScriptedVehicle("QC-1", first, PAPER_LANE_Y, PAPER_SPEED, 0.0),
@@ -382,7 +382,7 @@ def _paper_runs(bridge: BridgeModel, dt: float, runs: Sequence[tuple[str, str, b
 
     ``runs`` are (name, basis, moving_force) triples.
     """
-    from .simulation import Sensor, SolverSettings, simulate
+    from cosim.core.simulation import Sensor, SolverSettings, simulate
 
     x_mid = bridge.length / 2.0
     sensors = [Sensor(name, x_mid, y) for name, y in PAPER_NODES]
@@ -449,7 +449,7 @@ def _paper_case_setup(bridge: BridgeModel, dt: float) -> str:
 
 
 def _study_paper(run: _Run) -> list[CaseResult]:
-    from .scenario import load_scenario
+    from cosim.run.scenario import load_scenario
 
     group = "Paper case: 40 m double-tee (Figs. 4-6)"
     dt = run.settings.paper_dt
@@ -732,8 +732,8 @@ def _euler_bernoulli_bridge(L: float = 20.0, n_el: int = 40) -> tuple[BridgeMode
 
 
 def _study_fryba(run: _Run) -> list[CaseResult]:
-    from .simulation import Sensor, SolverSettings, simulate
-    from .traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.simulation import Sensor, SolverSettings, simulate
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 
     group = "Moving force (Fryba)"
     bridge, sec = _euler_bernoulli_bridge()
@@ -779,7 +779,7 @@ def _study_fryba(run: _Run) -> list[CaseResult]:
 
 
 def _study_sprung_mass(run: _Run) -> list[CaseResult]:
-    from .simulation import Sensor, SolverSettings, simulate
+    from cosim.core.simulation import Sensor, SolverSettings, simulate
 
     group = "Moving sprung mass"
     s = run.settings
@@ -841,9 +841,9 @@ def _study_sprung_mass(run: _Run) -> list[CaseResult]:
 def _study_energy(run: _Run) -> list[CaseResult]:
     import scipy.sparse.linalg as spla
 
-    from .coupling import CoupledSystem
-    from .integrator import Scheme, make_basis
-    from .traffic import TrafficFrame
+    from cosim.core.coupling import CoupledSystem
+    from cosim.core.integrator import Scheme, make_basis
+    from cosim.core.traffic import TrafficFrame
 
     bridge, _ = _euler_bernoulli_bridge()
     dt, steps = 1e-3, run.settings.energy_steps
@@ -893,9 +893,9 @@ def _study_energy(run: _Run) -> list[CaseResult]:
 
 
 def _study_time_step(run: _Run) -> list[CaseResult]:
-    from .integrator import Scheme
-    from .simulation import Sensor, SolverSettings, simulate
-    from .traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.integrator import Scheme
+    from cosim.core.simulation import Sensor, SolverSettings, simulate
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 
     bridge, _ = _euler_bernoulli_bridge(L=10.0, n_el=10)
     duration, ref_steps = 0.4, 12800
@@ -957,7 +957,7 @@ def _study_time_step(run: _Run) -> list[CaseResult]:
 
 
 def _study_roughness(run: _Run) -> list[CaseResult]:
-    from .roughness import N0, N_MAX, N_MIN, averaged_psd, iso8608_band, iso8608_gd0, iso8608_profile
+    from cosim.core.roughness import N0, N_MAX, N_MIN, averaged_psd, iso8608_band, iso8608_gd0, iso8608_profile
 
     group = "ISO 8608 roughness"
     length = run.settings.roughness_length
@@ -1063,8 +1063,8 @@ def _study_mesh(run: _Run) -> list[CaseResult]:
 
 
 def _study_parked(run: _Run) -> list[CaseResult]:
-    from .simulation import Sensor, SolverSettings, simulate
-    from .traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.simulation import Sensor, SolverSettings, simulate
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 
     bridge = build_bridge([20.0], 20, STEEL, rectangle_section(1.0, 1.0), ["rigid-end", "rigid-end"],
                           ExplicitDamping(5.0, 1e-3))

@@ -109,7 +109,7 @@ def quasi_static(
 ) -> QuasiStaticResult:
     """Quasi-static sensor readings under ``traffic`` at every time step of a run.
 
-    The traffic is asked for the same times as :func:`cosim.simulation.simulate`
+    The traffic is asked for the same times as :func:`cosim.core.simulation.simulate`
     asks (``k dt``, k = 1 ... round(duration / dt)), so the vehicles stand exactly
     where they stood in the dynamic run. Each vehicle on the deck loads it with
     ``total_mass * gravity`` downwards.

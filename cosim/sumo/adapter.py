@@ -6,7 +6,7 @@ the bridge: position (front bumper), heading, speed,
 acceleration and type. Each vehicle becomes one quarter-car at its centre,
 half its length behind the bumper along the heading, projected onto the
 bridge axis (x along the axis from its start point, y to the left of it).
-The frames feed :class:`cosim.traffic.FrameTraffic`, which the beam sub-steps
+The frames feed :class:`cosim.core.traffic.FrameTraffic`, which the beam sub-steps
 through with SUMO's ballistic motion between frames.
 
 ``libsumo`` is a per-process singleton: one SUMO simulation per process.
@@ -23,9 +23,9 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from .errors import ConfigError, SumoError
-from .traffic import Frame, FrameTraffic, TrafficBlock
-from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.errors import ConfigError, SumoError
 
 PARAM_PREFIX = "cosim."
 WATCH_MARGIN = 12.0  # m: watch edges reaching this far past the deck ends (half the longest vehicle + slack)

@@ -7,15 +7,15 @@ its unit, default and constraints.
 
 Typical use::
 
-    from cosim.scenario import load_scenario
+    from cosim.run.scenario import load_scenario
 
     scenario = load_scenario("paper-double-tee")      # a bundled scenario, or a path
-    bridge = scenario.build_bridge()                  # cosim.bridge.BridgeModel
-    result = scenario.simulate()                      # cosim.simulation.SimulationResult
+    bridge = scenario.build_bridge()                  # cosim.core.bridge.BridgeModel
+    result = scenario.simulate()                      # cosim.core.simulation.SimulationResult
 
 The pieces :meth:`Scenario.simulate` wires together are available one by one:
-:meth:`Scenario.build_vehicles` (a :class:`cosim.traffic.ScriptedTraffic`),
-:meth:`Scenario.build_road` (a :class:`cosim.roughness.RoadProfile`),
+:meth:`Scenario.build_vehicles` (a :class:`cosim.core.traffic.ScriptedTraffic`),
+:meth:`Scenario.build_road` (a :class:`cosim.core.roughness.RoadProfile`),
 :meth:`Scenario.solver_settings` and :meth:`Scenario.sensors_core`.
 
 Every problem with a scenario (missing file, TOML syntax, unknown or missing
@@ -58,14 +58,14 @@ from pydantic import (
     model_validator,
 )
 
-from .bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, ExplicitDamping, RayleighDamping, build_bridge
-from .bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
-from .errors import ConfigError, ModelError
-from .roughness import ISO_CLASSES, RoadProfile, iso8608_profile, profile_from_csv, smooth_road
-from .section import Material, Plate, SectionProperties, section_from_constants, section_from_plates
-from .simulation import Sensor, SimulationResult, SolverSettings, simulate
-from .traffic import ScriptedTraffic, ScriptedVehicle
-from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, ExplicitDamping, RayleighDamping, build_bridge
+from cosim.core.bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
+from cosim.core.roughness import ISO_CLASSES, RoadProfile, iso8608_profile, profile_from_csv, smooth_road
+from cosim.core.section import Material, Plate, SectionProperties, section_from_constants, section_from_plates
+from cosim.core.simulation import Sensor, SimulationResult, SolverSettings, simulate
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.errors import ConfigError, ModelError
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -536,7 +536,7 @@ class MaterialConfig(_Model):
         return self.E / (2.0 * self.shear_modulus) - 1.0
 
     def to_material(self) -> Material:
-        """The :class:`cosim.section.Material` this table describes."""
+        """The :class:`cosim.core.section.Material` this table describes."""
         return Material(E=self.E, G=self.shear_modulus, rho=self.rho)
 
 
@@ -562,7 +562,7 @@ class PlateConfig(_Model):
         return (min(y1, y2) - half, max(y1, y2) + half)
 
     def to_plate(self) -> Plate:
-        """The :class:`cosim.section.Plate` this table describes."""
+        """The :class:`cosim.core.section.Plate` this table describes."""
         return Plate(start=self.start, end=self.end, thickness=self.thickness)
 
 
@@ -683,7 +683,7 @@ class DampingConfig(_Model):
         return self
 
     def to_damping(self) -> RayleighDamping | ExplicitDamping:
-        """The :mod:`cosim.bridge` damping specification."""
+        """The :mod:`cosim.core.bridge` damping specification."""
         if self.ratios is not None:
             assert self.modes is not None
             return RayleighDamping(ratios=tuple(self.ratios), modes=tuple(self.modes))
@@ -842,7 +842,7 @@ class VehicleConfig(_Model):
         return values
 
     def to_model(self) -> VehicleModel:
-        """The :mod:`cosim.vehicles` model this table describes.
+        """The :mod:`cosim.core.vehicles` model this table describes.
 
         Raises:
             ConfigError: a non-physical parameter (the vehicle classes check them).
@@ -857,7 +857,7 @@ class VehicleConfig(_Model):
         return TyreQuarterCar.golden_car(p["m_v"])
 
     def to_scripted(self) -> ScriptedVehicle:
-        """The :class:`cosim.traffic.ScriptedVehicle` this table describes."""
+        """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes."""
         return ScriptedVehicle(
             id=self.id,
             model=self.to_model(),
@@ -967,7 +967,7 @@ class SolverConfig(_Model):
         return self
 
     def to_settings(self) -> SolverSettings:
-        """The :class:`cosim.simulation.SolverSettings` this table describes."""
+        """The :class:`cosim.core.simulation.SolverSettings` this table describes."""
         return SolverSettings(
             dt=self.dt,
             scheme=self.scheme,
@@ -1217,7 +1217,7 @@ class Scenario(_Model):
         return Path(self._source).stem or self._source
 
     def material(self) -> Material:
-        """The bridge's :class:`cosim.section.Material`."""
+        """The bridge's :class:`cosim.core.section.Material`."""
         return self.bridge.material.to_material()
 
     def build_section(self) -> SectionProperties:
@@ -1231,7 +1231,7 @@ class Scenario(_Model):
             return self.bridge.section.build(nu=self.bridge.material.poisson)
 
     def build_bridge(self) -> BridgeModel:
-        """The finite-element bridge model (:func:`cosim.bridge.build_bridge`).
+        """The finite-element bridge model (:func:`cosim.core.bridge.build_bridge`).
 
         Raises:
             ConfigError, ModelError: the section or the model cannot be built (e.g. a
@@ -1310,7 +1310,7 @@ class Scenario(_Model):
         return leave + RING_DOWN
 
     def build_vehicles(self) -> ScriptedTraffic:
-        """The scripted vehicles as a :class:`cosim.traffic.ScriptedTraffic` on this bridge's length."""
+        """The scripted vehicles as a :class:`cosim.core.traffic.ScriptedTraffic` on this bridge's length."""
         with self._named("vehicles"):
             return ScriptedTraffic(tuple(v.to_scripted() for v in self.vehicles), self.bridge.length)
 
@@ -1333,13 +1333,13 @@ class Scenario(_Model):
         if self.traffic is None:
             return None
         if self.traffic.bundled:
-            from .sumo import bundled_networks
+            from cosim.sumo.adapter import bundled_networks
 
             return bundled_networks() / f"{self.traffic.sumo_config}.sumocfg"
         return Path(self._base_dir) / self.traffic.sumo_config
 
     def build_traffic(self, frame_sink: Callable[..., None] | None = None) -> Any:
-        """The traffic source: :class:`cosim.sumo.SumoTraffic` (not started) for ``[traffic]``, else the
+        """The traffic source: :class:`cosim.sumo.adapter.SumoTraffic` (not started) for ``[traffic]``, else the
         scripted vehicles (:meth:`build_vehicles`).
 
         Args:
@@ -1347,7 +1347,7 @@ class Scenario(_Model):
         """
         if self.traffic is None:
             return self.build_vehicles()
-        from .sumo import BridgeAxis, SumoTraffic  # only SUMO runs load libsumo
+        from cosim.sumo.adapter import BridgeAxis, SumoTraffic  # only SUMO runs load libsumo
 
         t = self.traffic
         length = self.bridge.length
@@ -1387,11 +1387,11 @@ class Scenario(_Model):
             )
 
     def solver_settings(self) -> SolverSettings:
-        """The :class:`cosim.simulation.SolverSettings` of ``[solver]``."""
+        """The :class:`cosim.core.simulation.SolverSettings` of ``[solver]``."""
         return self.solver.to_settings()
 
     def sensors_core(self) -> list[Sensor]:
-        """The ``[[sensors]]`` as :class:`cosim.simulation.Sensor` objects."""
+        """The ``[[sensors]]`` as :class:`cosim.core.simulation.Sensor` objects."""
         return [Sensor(name=s.name, x=s.x, y=s.y, quantity=s.quantity) for s in self.sensors]
 
     def simulate(
@@ -1400,7 +1400,7 @@ class Scenario(_Model):
         *,
         bridge: BridgeModel | None = None,
     ) -> SimulationResult:
-        """Run the scenario: bridge, scripted vehicles, road, solver and sensors into :func:`cosim.simulation.simulate`.
+        """Run the scenario: bridge, scripted vehicles, road, solver and sensors into :func:`cosim.core.simulation.simulate`.
 
         Args:
             progress: called with the fraction done from time to time.

@@ -1,7 +1,7 @@
 """Closed-form and independent reference solutions (DESIGN.md section 8).
 
 The one copy of every reference the verification tests (``tests/verification``)
-and ``cosim validate`` (:mod:`cosim.validation`) compare the model with. Each
+and ``cosim validate`` (:mod:`cosim.validation.cases`) compare the model with. Each
 function names its source. numpy and scipy only.
 
 Sign convention as in the model: ``z`` up, a load ``P < 0`` pushes down and
@@ -13,8 +13,8 @@ import numpy as np
 import numpy.typing as npt
 from scipy.integrate import solve_ivp
 
-from .errors import ConfigError, ModelError
-from .section import Material, SectionProperties
+from cosim.errors import ConfigError, ModelError
+from cosim.core.section import Material, SectionProperties
 
 __all__ = [
     "STEEL",
@@ -284,9 +284,9 @@ def yang_yau_case():
     1e-3 m^2) and shear flexibility, so the Euler-Bernoulli modal reference
     (:func:`sprung_mass_modal_solution`) applies.
     """
-    from .bridge import build_bridge
-    from .traffic import ScriptedTraffic, ScriptedVehicle
-    from .vehicles import QuarterCar
+    from cosim.core.bridge import build_bridge
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.vehicles import QuarterCar
 
     p = YANG_YAU
     mat = Material(E=p["EI"] / 1e-3, G=1e12, rho=p["m"])

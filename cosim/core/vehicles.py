@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 from typing import Union
 
-from .errors import ConfigError
+from cosim.errors import ConfigError
 
 
 def _positive(owner: str, **values: float) -> None:

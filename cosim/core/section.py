@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ConfigError, ModelError
+from cosim.errors import ConfigError, ModelError
 
 
 @dataclass(frozen=True)

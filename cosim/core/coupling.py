@@ -25,7 +25,7 @@ included, while inertia (bridge and rigid-contact wheel) stays at t_{n+1}::
 It becomes ``(A + U P^T) a = b`` with the constant, once-factorised
 ``A = M + (1+alpha)(gamma dt C + beta dt^2 K)``, ``U = [n0_i]`` and
 ``P = [p_i]``: a rank-q update solved with the Woodbury identity. The loop
-itself runs compiled (:mod:`cosim.kernels`).
+itself runs compiled (:mod:`cosim.core.kernels`).
 """
 from __future__ import annotations
 
@@ -34,9 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cosim.errors import ModelError
+
 from . import kernels
 from .bridge import BridgeModel
-from .errors import ModelError
 from .integrator import DirectBasis, ModalBasis, Scheme
 from .roughness import RoadProfile, smooth_road
 from .traffic import TrafficBlock, TrafficFrame

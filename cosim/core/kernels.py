@@ -7,7 +7,7 @@ version of the step about ten times slower than its arithmetic (measured
 while developing it: ~200 us against ~20 us now for the paper bridge with
 one vehicle; benchmarks/bench_step.py times this kernel against a naive
 sparse solver and OpenSeesPy). The mathematics is documented in
-:mod:`cosim.coupling`; this module is its only implementation.
+:mod:`cosim.core.coupling`; this module is its only implementation.
 
 Conventions shared by both bases:
 

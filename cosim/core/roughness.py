@@ -18,7 +18,7 @@ from typing import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from .errors import ConfigError
+from cosim.errors import ConfigError
 
 ISO_CLASSES = "ABCDEFGH"
 N0 = 0.1  # reference spatial frequency, cycle/m

@@ -20,7 +20,7 @@ For every run cosim writes the SUMO files and the scenario it generated into
 ``<output>/runs/<run id>/``, runs the scenario there into ``run.mcap`` and
 reduces it to one row of results (``result.json``): peaks and percentiles per
 sensor, RMS, the dynamic amplification factor against a quasi-static run of the
-same traffic (:mod:`cosim.quasistatic`), vehicle counts, lift-offs, wall time
+same traffic (:mod:`cosim.core.quasistatic`), vehicle counts, lift-offs, wall time
 and status. The rows make ``<output>/results.csv`` and ``results.parquet``;
 ``<output>/plots/`` gets one PNG per statistic against every swept axis.
 
@@ -53,14 +53,24 @@ from typing import Annotated, Any, Callable, Sequence
 import numpy as np
 from pydantic import Field, PlainValidator, Strict, ValidationError, field_validator
 
-from .errors import ConfigError, CosimError
-from .log import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, file_is_complete, read_log, traffic_from_log
-from .quasistatic import daf, quasi_static
-from .roughness import ISO_CLASSES as _ISO
+from cosim.core.quasistatic import daf, quasi_static
+from cosim.core.roughness import ISO_CLASSES as _ISO
+from cosim.errors import ConfigError, CosimError
+from cosim.log.writer import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, file_is_complete, read_log, traffic_from_log
 
 ISO_CLASSES = tuple(_ISO)
-from .scenario import (ROAD_CLASSES, SUMO_LEVELS, Scenario, _config_error, _fail, _Model, _Problems, _show,
-                       list_bundled_scenarios, load_scenario)
+from cosim.run.scenario import (
+    ROAD_CLASSES,
+    SUMO_LEVELS,
+    Scenario,
+    _config_error,
+    _fail,
+    _Model,
+    _Problems,
+    _show,
+    list_bundled_scenarios,
+    load_scenario,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -128,7 +138,7 @@ _Percent = Annotated[float, Strict(), Field(gt=0.0, le=100.0)]
 
 def _road_class(value: Any) -> str:
     if not isinstance(value, str) or value not in ROAD_CLASSES:
-        from .scenario import _choices_message
+        from cosim.run.scenario import _choices_message
 
         raise _fail(_choices_message(value, ROAD_CLASSES, "road class"))
     return value
@@ -234,7 +244,7 @@ def _xml_bytes(root: ET.Element, note: str) -> bytes:
 
 def bundled_config(level: str) -> Path:
     """``sumo_networks/<level>.sumocfg`` of a bundled demand level."""
-    from .sumo import bundled_networks
+    from cosim.sumo.adapter import bundled_networks
 
     return bundled_networks() / f"{level}.sumocfg"
 
@@ -587,7 +597,7 @@ class Study:
             seeds["sumo_seed"] = traffic.get("seed")
         elif self.duration is not None:
             data.setdefault("solver", {})["duration"] = self.duration
-        from .runner import toml_dumps
+        from cosim.run.logged import toml_dumps
 
         return toml_dumps(data), files, seeds
 
@@ -727,7 +737,7 @@ def _base_row(task: RunTask) -> dict[str, Any]:
 def _sensor_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: Sequence[float]
                        ) -> dict[str, Any]:
     """Peaks, percentiles, RMS, quasi-static peak and DAF per sensor; vehicle counts of the run."""
-    from .runner import sensor_series
+    from cosim.run.logged import sensor_series
 
     result = outcome.result
     sensors = scenario.sensors_core()
@@ -801,7 +811,7 @@ def execute_run(task: RunTask) -> dict[str, Any]:
         _write(folder / SCENARIO_FILE, task.scenario_text)
         scenario = load_scenario(folder / SCENARIO_FILE)
         bridge = scenario.build_bridge()
-        from .runner import run_logged
+        from cosim.run.logged import run_logged
 
         outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge)
         row.update(_sensor_statistics(scenario, bridge, outcome, task.percentiles))
@@ -1126,7 +1136,7 @@ MAX_GROUPS = 6
 
 def _statistics(study: Study, frame) -> list[tuple[str, str, float]]:  # noqa: ANN001
     """(column, label, display factor) of every plotted statistic."""
-    from .runner import DISPLAY_UNITS
+    from cosim.run.logged import DISPLAY_UNITS
 
     out = []
     for sensor in study.base.sensors:

@@ -9,7 +9,7 @@ Subcommands::
     cosim info LOG.mcap
     cosim plot LOG.mcap [--sensor NAME ...] -o FIG.png [--force]
 
-The work is done by :mod:`cosim.runner`; this module parses and prints.
+The work is done by :mod:`cosim.run.logged`; this module parses and prints.
 
 Every :class:`cosim.errors.CosimError` becomes ``cosim: error: <message>`` on
 stderr and exit status 2 (as for usage errors); a :class:`cosim.errors.ModelError`
@@ -30,13 +30,14 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from . import __version__, runner
-from .bridge import BridgeModel, ModalResult, PointLoad
-from .errors import CosimError
-from .log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
-from .traffic import vehicle_of
-from .scenario import Scenario, list_bundled_scenarios, load_scenario
-from .section import SectionProperties
+from cosim import __version__
+from cosim.core.bridge import BridgeModel, ModalResult, PointLoad
+from cosim.core.section import SectionProperties
+from cosim.core.traffic import vehicle_of
+from cosim.errors import CosimError
+from cosim.log.writer import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
+from cosim.run import logged as runner
+from cosim.run.scenario import Scenario, list_bundled_scenarios, load_scenario
 
 DEFAULT_SCENARIO = "paper-bridge-traffic"
 STATIC_LOAD_N = 100e3
@@ -1018,7 +1019,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
-    from .studies import load_study, run_study, summary_text
+    from cosim.study.study import load_study, run_study, summary_text
 
     study = load_study(args.study, output=args.out)
     bar: Any = None
@@ -1063,7 +1064,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from .validation import run_validation
+    from cosim.validation.cases import run_validation
 
     def progress(done: int, total: int, label: str) -> None:
         print(f"[{done}/{total}] {label}", file=sys.stderr, flush=True)
