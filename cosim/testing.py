@@ -301,7 +301,12 @@ class Results:
 
     def _traffic(self) -> Any:
         if self.log_path is not None:
-            from cosim.log.writer import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, read_log, traffic_from_log
+            from cosim.log.writer import (
+                TOPIC_TRAFFIC,
+                TOPIC_VEHICLE_TYPES,
+                read_log,
+                traffic_from_log,
+            )
 
             traffic_cfg = self.scenario.traffic
             if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)

@@ -33,7 +33,15 @@ import orjson
 from mcap.exceptions import McapError
 from mcap.opcode import Opcode
 from mcap.reader import make_reader
-from mcap.records import Attachment, Channel, Footer, Header, Message, MessageIndex, Metadata
+from mcap.records import (
+    Attachment,
+    Channel,
+    Footer,
+    Header,
+    Message,
+    MessageIndex,
+    Metadata,
+)
 from mcap.stream_reader import StreamReader
 from mcap.writer import CompressionType, Writer
 

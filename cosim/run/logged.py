@@ -716,7 +716,11 @@ def _overview_from_summary(path: Path, fh: Any, out: LogOverview) -> tuple[str |
     from mcap.data_stream import ReadDataStream
     from mcap.reader import make_reader
     from mcap.records import Chunk, Message
-    from mcap.stream_reader import CRCValidationError, breakup_chunk, get_chunk_data_stream
+    from mcap.stream_reader import (
+        CRCValidationError,
+        breakup_chunk,
+        get_chunk_data_stream,
+    )
 
     try:
         reader = make_reader(fh, validate_crcs=True)

@@ -33,21 +33,16 @@ from __future__ import annotations
 
 import contextlib
 import datetime
-import difflib
-import json
 import math
 import os
 import re
 import sys
-import types
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Callable, Iterator, Union, get_args, get_origin
+from typing import Annotated, Any, Callable, Iterator, Union
 
 import numpy as np
 from pydantic import (
-    BaseModel,
-    ConfigDict,
     Field,
     PlainValidator,
     PrivateAttr,
@@ -58,14 +53,54 @@ from pydantic import (
     model_validator,
 )
 
-from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, ExplicitDamping, RayleighDamping, build_bridge
+from cosim.core.bridge import (
+    DOF_NAMES,
+    SUPPORT_PRESETS,
+    BridgeModel,
+    ExplicitDamping,
+    RayleighDamping,
+    build_bridge,
+)
 from cosim.core.bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
-from cosim.core.roughness import ISO_CLASSES, RoadProfile, iso8608_profile, profile_from_csv, smooth_road
-from cosim.core.section import Material, Plate, SectionProperties, section_from_constants, section_from_plates
+from cosim.core.roughness import (
+    ISO_CLASSES,
+    RoadProfile,
+    iso8608_profile,
+    profile_from_csv,
+    smooth_road,
+)
+from cosim.core.section import (
+    Material,
+    Plate,
+    SectionProperties,
+    section_from_constants,
+    section_from_plates,
+)
 from cosim.core.simulation import Sensor, SimulationResult, SolverSettings, simulate
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 from cosim.errors import ConfigError, ModelError
+from cosim.run.config_base import (
+    ConfigModel,
+    Interval,
+    NetPoint,
+    NonNegative,
+    Number,
+    Point,
+    Positive,
+    PositiveInt,
+    Problems,
+    Text,
+    choice,
+    choices_message,
+    config_error,
+    describe,
+    fail,
+    number_problem,
+    number_text,
+    show,
+    suggest,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -122,9 +157,6 @@ ROAD_CLASSES: tuple[str, ...] = (*ISO_CLASSES, "smooth")
 #: Random road profiles cover the deck plus this margin at both ends, m.
 ROAD_MARGIN = 10.0
 
-#: Top-level sections that later versions add; rejected for now with a clear note.
-FUTURE_SECTIONS: dict[str, str] = {}
-
 #: ``[traffic].sumo_config`` may name one of these bundled demand levels (sumo_networks/<level>.sumocfg).
 SUMO_LEVELS: tuple[str, ...] = ("light", "medium", "heavy", "congested")
 #: With SUMO traffic, random road profiles are laid on wheel paths this far apart across the deck, m.
@@ -142,276 +174,10 @@ DEFAULT_OUTPUT_DIR = "runs"
 DEFAULT_RATE_HZ = 100.0
 
 
-# --------------------------------------------------------------------------- errors
-
-
-class _Problems(ValueError):
-    """Problems found by a validator, each with a key path relative to the value checked."""
-
-    def __init__(self, problems: list[tuple[tuple[str | int, ...], str]]) -> None:
-        super().__init__("; ".join(msg for _, msg in problems))
-        self.problems = problems
-
-
-def _fail(message: str, *loc: str | int) -> _Problems:
-    return _Problems([(tuple(loc), message)])
-
-
-def _num(value: float) -> str:
-    """A bound for messages: 0 rather than 0.0, -0.333333 rather than 16 digits."""
-    value = float(value)
-    if value.is_integer():
-        return str(int(value))
-    return f"{value:.6g}"
-
-
-def _show(value: Any, limit: int = 60) -> str:
-    """A TOML-looking rendering of a value for error messages."""
-    if isinstance(value, bool):
-        text = "true" if value else "false"
-    elif isinstance(value, str):
-        text = json.dumps(value, ensure_ascii=False)
-    elif isinstance(value, float):
-        text = repr(value) if value == 0 or 1e-4 <= abs(value) < 1e6 else f"{value:.10g}"
-    elif isinstance(value, (list, tuple)):
-        text = "[" + ", ".join(_show(v, limit) for v in value) + "]"
-    elif isinstance(value, dict):
-        text = "{" + ", ".join(f"{k} = {_show(v, limit)}" for k, v in value.items()) + "}"
-    else:
-        text = str(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-def _describe(value: Any) -> str:
-    """What kind of TOML value was found: 'string "0.005"', 'a table', ..."""
-    if isinstance(value, bool):
-        return f"boolean {_show(value)}"
-    if isinstance(value, (int, float)):
-        return f"number {_show(value)}"
-    if isinstance(value, str):
-        return f"string {_show(value)}"
-    if isinstance(value, dict):
-        return f"a table {_show(value)}"
-    if isinstance(value, (list, tuple)):
-        return f"an array {_show(value)}"
-    return f"{type(value).__name__} {_show(value)}"
-
-
-def _path(loc: tuple[str | int, ...]) -> str:
-    text = ""
-    for part in loc:
-        if isinstance(part, int):
-            text += f"[{part}]"
-        else:
-            text += ("." if text else "") + str(part)
-    return text or "(top level)"
-
-
-def _unwrap(annotation: Any) -> Any:
-    """Strip Annotated and Optional from a field annotation."""
-    while True:
-        origin = get_origin(annotation)
-        if origin is Annotated:
-            annotation = get_args(annotation)[0]
-        elif origin is Union or isinstance(annotation, types.UnionType):
-            args = [a for a in get_args(annotation) if a is not type(None)]
-            if len(args) != 1:
-                return annotation
-            annotation = args[0]
-        else:
-            return annotation
-
-
-def _keys(model: type[BaseModel]) -> list[str]:
-    """The TOML keys of a table: field aliases where given (``class``), else field names."""
-    return [field.alias or name for name, field in model.model_fields.items()]
-
-
-def _field(model: type[BaseModel], key: str) -> Any:
-    for name, field in model.model_fields.items():
-        if key in (name, field.alias):
-            return field
-    return None
-
-
-def _model_at(root: type[BaseModel], loc: tuple[str | int, ...]) -> type[BaseModel] | None:
-    """The model class that validates the table at ``loc`` (None if not a table)."""
-    annotation: Any = root
-    for part in loc:
-        annotation = _unwrap(annotation)
-        if isinstance(part, int):
-            if get_origin(annotation) not in (tuple, list):
-                return None
-            annotation = get_args(annotation)[0]
-            continue
-        if not (isinstance(annotation, type) and issubclass(annotation, BaseModel)):
-            return None
-        field = _field(annotation, part)
-        if field is None:
-            return None
-        annotation = field.annotation
-    annotation = _unwrap(annotation)
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    return None
-
-
-def _suggest(word: str, choices: list[str] | tuple[str, ...]) -> str | None:
-    lowered = {c.lower(): c for c in choices}
-    if word.lower() in lowered:
-        return lowered[word.lower()]
-    scored = sorted(
-        ((difflib.SequenceMatcher(None, word, c).ratio(), c) for c in choices), reverse=True
-    )
-    if not scored or scored[0][0] < 0.6:
-        return None
-    if len(scored) > 1 and scored[1][0] == scored[0][0]:
-        return None  # ambiguous: no suggestion rather than a wrong one
-    return scored[0][1]
-
-
-def _choices_message(value: Any, choices: tuple[str, ...] | list[str], what: str = "") -> str:
-    listed = ", ".join(choices)
-    if not isinstance(value, str):
-        return f"expected {what or 'a string'}, one of: {listed} (got {_describe(value)})"
-    hint = _suggest(value, choices)
-    hint_text = f'; did you mean "{hint}"?' if hint else ""
-    return f"unknown {what or 'value'} {_show(value)}{hint_text} (expected one of: {listed})"
-
-
-_TYPE_EXPECTED = {
-    "float_type": "a number",
-    "float_parsing": "a number",
-    "int_type": "an integer",
-    "int_parsing": "an integer",
-    "int_from_float": "an integer",
-    "string_type": "a string",
-    "bool_type": "a boolean",
-    "model_type": "a table",
-    "model_attributes_type": "a table",
-    "dict_type": "a table",
-    "tuple_type": "an array",
-    "list_type": "an array",
-}
-
-_BOUNDS = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<", "less_than_equal": "<="}
-
-
-def _format_one(root: type[BaseModel], error: dict[str, Any]) -> list[tuple[str, str]]:
-    """(dotted key, message) pairs for one pydantic error."""
-    loc: tuple[str | int, ...] = tuple(error["loc"])
-    kind = error["type"]
-    value = error.get("input")
-    ctx = error.get("ctx") or {}
-
-    if kind == "value_error" and isinstance(ctx.get("error"), _Problems):
-        return [(_path(loc + rel), msg) for rel, msg in ctx["error"].problems]
-    if kind in ("value_error", "assertion_error"):
-        message = str(ctx.get("error", error["msg"]))
-        return [(_path(loc), message)]
-    if kind == "extra_forbidden":
-        parent = _model_at(root, loc[:-1])
-        allowed = _keys(parent) if parent is not None else []
-        key = str(loc[-1])
-        listed = f"expected one of: {', '.join(allowed)}" if allowed else "no keys expected here"
-        if len(loc) == 1 and key in FUTURE_SECTIONS:
-            return [(_path(loc), f"not supported yet (planned for a later version: {FUTURE_SECTIONS[key]}; {listed})")]
-        hint = _suggest(key, allowed)
-        hint_text = f'; did you mean "{hint}"?' if hint else ""
-        return [(_path(loc), f"unknown key{hint_text} ({listed})")]
-    if kind == "missing":
-        return [(_path(loc), "required key is missing")]
-    if kind in _TYPE_EXPECTED:
-        expected = _TYPE_EXPECTED[kind]
-        if kind in ("tuple_type", "list_type") and isinstance(value, dict):
-            return [(_path(loc), f"expected an array of tables ([[{_path(loc)}]]), got a single table")]
-        if kind in ("model_type", "dict_type") and isinstance(value, (list, tuple)):
-            return [(_path(loc), f"expected a table ([{_path(loc)}]), got {_describe(value)}")]
-        return [(_path(loc), f"expected {expected}, got {_describe(value)}")]
-    if kind in _BOUNDS:
-        bound = next(iter(ctx.values()))
-        return [(_path(loc), f"must be {_BOUNDS[kind]} {_num(bound)} (got {_show(value)})")]
-    if kind == "finite_number":
-        return [(_path(loc), f"must be a finite number (got {_show(value)})")]
-    if kind == "too_short":
-        return [(_path(loc), f"expected at least {ctx.get('min_length')} item(s), got {ctx.get('actual_length')}")]
-    if kind == "too_long":
-        return [(_path(loc), f"expected at most {ctx.get('max_length')} item(s), got {ctx.get('actual_length')}")]
-    if kind == "string_too_short":
-        return [(_path(loc), f"must not be empty (got {_show(value)})")]
-    if kind == "string_pattern_mismatch":
-        return [(_path(loc), f"may contain only letters, digits, '_', '.' and '-' (got {_show(value)})")]
-    return [(_path(loc), f"{error['msg']} (got {_show(value)})")]
-
-
-def _config_error(source: str, root: type[BaseModel], exc: ValidationError) -> ConfigError:
-    errors = exc.errors(include_url=False)
-    # A misspelt key also makes its correct spelling "missing": report the
-    # misspelling (with its suggestion) only.
-    suggested: set[tuple[str | int, ...]] = set()
-    for error in errors:
-        if error["type"] == "extra_forbidden":
-            loc = tuple(error["loc"])
-            parent = _model_at(root, loc[:-1])
-            hint = _suggest(str(loc[-1]), _keys(parent)) if parent is not None else None
-            if hint is not None:
-                suggested.add(loc[:-1] + (hint,))
-    lines: list[str] = []
-    for error in errors:
-        if error["type"] == "missing" and tuple(error["loc"]) in suggested:
-            continue
-        for key, message in _format_one(root, error):
-            lines.append(f"{source}: {key}: {message}")
-    if len(lines) > 1:
-        more = len(lines) - 1
-        lines.insert(1, f"({more} more problem{'s' if more > 1 else ''}:)")
-    return ConfigError("\n".join(lines))
-
-
-# --------------------------------------------------------------------------- field types
-
-Number = Annotated[float, Strict()]
-"""A float; integers are accepted, strings and booleans are not."""
-Positive = Annotated[float, Strict(), Field(gt=0)]
-NonNegative = Annotated[float, Strict(), Field(ge=0)]
-PositiveInt = Annotated[int, Strict(), Field(ge=1)]
-Text = Annotated[str, Strict()]
-
-
-def _pair(value: Any, names: str) -> tuple[float, float]:
-    if not isinstance(value, (list, tuple)) or len(value) != 2:
-        raise _fail(f"expected an array of 2 numbers [{names}], got {_describe(value)}")
-    problems = []
-    for i, item in enumerate(value):
-        if isinstance(item, bool) or not isinstance(item, (int, float)):
-            problems.append(((i,), f"expected a number, got {_describe(item)}"))
-        elif not math.isfinite(item):
-            problems.append(((i,), f"must be a finite number (got {_show(item)})"))
-    if problems:
-        raise _Problems(problems)
-    return (float(value[0]), float(value[1]))
-
-
-Point = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "y, z"))]
-"""A section point (y, z) in metres."""
-Interval = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "min, max"))]
-NetPoint = Annotated[tuple[float, float], PlainValidator(lambda v: _pair(v, "x, y"))]
-"""A point (x, y) in SUMO network coordinates, m."""
-
-
-def _choice(choices: tuple[str, ...], what: str):  # noqa: ANN202 - returns a validator
-    def check(value: Any) -> str:
-        if not isinstance(value, str) or value not in choices:
-            raise _fail(_choices_message(value, choices, what))
-        return value
-
-    return PlainValidator(check)
-
-
 def _count_problem(item: Any) -> str | None:
     """Why ``item`` is not an element count (an integer >= 1), or None."""
     if isinstance(item, bool) or not isinstance(item, int):
-        return f"expected an integer >= 1, got {_describe(item)}"
+        return f"expected an integer >= 1, got {describe(item)}"
     if item < 1:
         return f"must be >= 1 (got {item})"
     return None
@@ -420,57 +186,57 @@ def _count_problem(item: Any) -> str | None:
 def _elements_per_span(value: Any) -> int | tuple[int, ...]:
     if isinstance(value, (list, tuple)):
         if not value:
-            raise _fail("expected an integer or a non-empty array of integers (one per span), got []")
+            raise fail("expected an integer or a non-empty array of integers (one per span), got []")
         problems = [((i,), msg) for i, item in enumerate(value) if (msg := _count_problem(item))]
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return tuple(value)
     problem = _count_problem(value)
     if problem is not None:
         if isinstance(value, int) and not isinstance(value, bool):
-            raise _fail(problem)
-        raise _fail(f"expected an integer >= 1 or an array of them (one per span), got {_describe(value)}")
+            raise fail(problem)
+        raise fail(f"expected an integer >= 1 or an array of them (one per span), got {describe(value)}")
     return value
 
 
 def _supports(value: Any) -> tuple[str | tuple[str, ...], ...]:
     preset_names = tuple(SUPPORT_PRESETS)
     if not isinstance(value, (list, tuple)):
-        raise _fail(
+        raise fail(
             "expected an array with one entry per support line (a preset name or an array of DOF names), "
-            f"got {_describe(value)}"
+            f"got {describe(value)}"
         )
     problems: list[tuple[tuple[int, ...], str]] = []
     result: list[str | tuple[str, ...]] = []
     for i, item in enumerate(value):
         if isinstance(item, str):
             if item not in SUPPORT_PRESETS:
-                problems.append(((i,), _choices_message(item, preset_names, "support preset")))
+                problems.append(((i,), choices_message(item, preset_names, "support preset")))
             result.append(item)
         elif isinstance(item, (list, tuple)):
             seen: set[str] = set()
             for j, dof in enumerate(item):
                 if not isinstance(dof, str) or dof not in DOF_NAMES:
-                    problems.append(((i, j), _choices_message(dof, DOF_NAMES, "DOF name")))
+                    problems.append(((i, j), choices_message(dof, DOF_NAMES, "DOF name")))
                 elif dof in seen:
-                    problems.append(((i, j), f"DOF {_show(dof)} is listed twice"))
+                    problems.append(((i, j), f"DOF {show(dof)} is listed twice"))
                 else:
                     seen.add(dof)
             result.append(tuple(item))
         else:
             problems.append(
                 ((i,), f"expected a preset name ({', '.join(preset_names)}) or an array of DOF names "
-                       f"({', '.join(DOF_NAMES)}), got {_describe(item)}")
+                       f"({', '.join(DOF_NAMES)}), got {describe(item)}")
             )
     if problems:
-        raise _Problems(problems)
+        raise Problems(problems)
     return tuple(result)
 
 
 def _mode_ref(value: Any) -> int | str:
     if isinstance(value, int) and not isinstance(value, bool):
         if value < 1:
-            raise _fail(f"a mode number is 1-based: must be >= 1 (got {value})")
+            raise fail(f"a mode number is 1-based: must be >= 1 (got {value})")
         return value
     if isinstance(value, str):
         match = _MODE_REF.fullmatch(value)
@@ -478,13 +244,13 @@ def _mode_ref(value: Any) -> int | str:
             return value
         hint = ""
         if match and match["kind"] not in MODE_KINDS:
-            near = _suggest(match["kind"], MODE_KINDS)
+            near = suggest(match["kind"], MODE_KINDS)
             hint = f'; did you mean "{near}-{match["n"]}"?' if near else ""
-        raise _fail(
-            f'unknown mode reference {_show(value)}{hint} (expected a 1-based mode number or "<kind>-<n>" '
+        raise fail(
+            f'unknown mode reference {show(value)}{hint} (expected a 1-based mode number or "<kind>-<n>" '
             f"with kind one of: {', '.join(MODE_KINDS)}, e.g. \"vertical-1\")"
         )
-    raise _fail(f'expected a 1-based mode number or a string like "vertical-1", got {_describe(value)}')
+    raise fail(f'expected a 1-based mode number or a string like "vertical-1", got {describe(value)}')
 
 
 ModeRef = Annotated[Union[int, str], PlainValidator(_mode_ref)]
@@ -494,11 +260,9 @@ ModeRef = Annotated[Union[int, str], PlainValidator(_mode_ref)]
 # --------------------------------------------------------------------------- models
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
-class MaterialConfig(_Model):
+class MaterialConfig(ConfigModel):
     """``[bridge.material]``: linear elastic isotropic material (exactly one of G, nu)."""
 
     E: Positive
@@ -509,13 +273,13 @@ class MaterialConfig(_Model):
     @model_validator(mode="after")
     def _one_of_g_nu(self) -> MaterialConfig:
         if self.G is not None and self.nu is not None:
-            raise _fail(f"give exactly one of G or nu, got both (G = {_show(self.G)}, nu = {_show(self.nu)})")
+            raise fail(f"give exactly one of G or nu, got both (G = {show(self.G)}, nu = {show(self.nu)})")
         if self.G is None and self.nu is None:
-            raise _fail("give exactly one of G (shear modulus, Pa) or nu (Poisson's ratio), got neither")
+            raise fail("give exactly one of G (shear modulus, Pa) or nu (Poisson's ratio), got neither")
         if self.G is not None:
             nu = self.E / (2.0 * self.G) - 1.0
             if not -1.0 < nu < 0.5:
-                raise _fail(
+                raise fail(
                     f"E and G imply nu = E/(2 G) - 1 = {nu:.4g}, outside the isotropic range (-1, 0.5)", "G"
                 )
         return self
@@ -540,7 +304,7 @@ class MaterialConfig(_Model):
         return Material(E=self.E, G=self.shear_modulus, rho=self.rho)
 
 
-class PlateConfig(_Model):
+class PlateConfig(ConfigModel):
     """``[[bridge.section.plates]]``: one thin-walled plate (midline segment + thickness)."""
 
     start: Point
@@ -550,7 +314,7 @@ class PlateConfig(_Model):
     @model_validator(mode="after")
     def _nonzero_length(self) -> PlateConfig:
         if self.start == self.end:
-            raise _fail(f"plate has zero length (end equals start = {_show(list(self.start))})", "end")
+            raise fail(f"plate has zero length (end equals start = {show(list(self.start))})", "end")
         return self
 
     @property
@@ -566,7 +330,7 @@ class PlateConfig(_Model):
         return Plate(start=self.start, end=self.end, thickness=self.thickness)
 
 
-class ConstantsConfig(_Model):
+class ConstantsConfig(ConfigModel):
     """``[bridge.section.constants]``: explicit section constants (SI units)."""
 
     A: Positive
@@ -588,19 +352,19 @@ class ConstantsConfig(_Model):
         problems = []
         if not self.deck_y[0] < self.deck_y[1]:
             problems.append(
-                (("deck_y",), f"expected [y_min, y_max] with y_min < y_max (got {_show(list(self.deck_y))})")
+                (("deck_y",), f"expected [y_min, y_max] with y_min < y_max (got {show(list(self.deck_y))})")
             )
         if self.I_y * self.I_z - self.I_yz**2 <= 0:
             problems.append(
-                (("I_yz",), f"I_y I_z - I_yz^2 must be > 0 (got I_y = {_show(self.I_y)}, I_z = {_show(self.I_z)}, "
-                            f"I_yz = {_show(self.I_yz)})")
+                (("I_yz",), f"I_y I_z - I_yz^2 must be > 0 (got I_y = {show(self.I_y)}, I_z = {show(self.I_z)}, "
+                            f"I_yz = {show(self.I_yz)})")
             )
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return self
 
 
-class SectionConfig(_Model):
+class SectionConfig(ConfigModel):
     """``[bridge.section]``: exactly one of ``plates`` or ``constants``."""
 
     mesh_size: Positive | None = None
@@ -610,13 +374,13 @@ class SectionConfig(_Model):
     @model_validator(mode="after")
     def _exactly_one(self) -> SectionConfig:
         if self.plates is not None and self.constants is not None:
-            raise _fail("give exactly one of [[bridge.section.plates]] or [bridge.section.constants], got both")
+            raise fail("give exactly one of [[bridge.section.plates]] or [bridge.section.constants], got both")
         if self.plates is None and self.constants is None:
-            raise _fail("give exactly one of [[bridge.section.plates]] or [bridge.section.constants], got neither")
+            raise fail("give exactly one of [[bridge.section.plates]] or [bridge.section.constants], got neither")
         if self.plates is not None and len(self.plates) == 0:
-            raise _fail("expected at least one plate, got an empty array", "plates")
+            raise fail("expected at least one plate, got an empty array", "plates")
         if self.constants is not None and self.mesh_size is not None:
-            raise _fail("only used with plates (the FE section solver); remove it for constants", "mesh_size")
+            raise fail("only used with plates (the FE section solver); remove it for constants", "mesh_size")
         return self
 
     @property
@@ -644,7 +408,7 @@ class SectionConfig(_Model):
         )
 
 
-class DampingConfig(_Model):
+class DampingConfig(ConfigModel):
     """``[bridge.damping]``: Rayleigh damping from two target ratios at two modes, or explicit alpha/beta."""
 
     ratios: tuple[Annotated[float, Strict(), Field(ge=0.0, lt=1.0)], ...] | None = None
@@ -656,14 +420,14 @@ class DampingConfig(_Model):
     @classmethod
     def _two(cls, value: tuple[Any, ...] | None) -> tuple[Any, ...] | None:
         if value is not None and len(value) != 2:
-            raise _fail(f"expected exactly 2 entries (Rayleigh damping fits two modes), got {len(value)}")
+            raise fail(f"expected exactly 2 entries (Rayleigh damping fits two modes), got {len(value)}")
         return value
 
     @field_validator("modes")
     @classmethod
     def _distinct(cls, value: tuple[Any, ...] | None) -> tuple[Any, ...] | None:
         if value is not None and value[0] == value[1]:
-            raise _fail(f"the two modes must differ (got {_show(value[0])} twice)")
+            raise fail(f"the two modes must differ (got {show(value[0])} twice)")
         return value
 
     @model_validator(mode="after")
@@ -671,15 +435,15 @@ class DampingConfig(_Model):
         rayleigh = self.ratios is not None or self.modes is not None
         explicit = self.alpha is not None or self.beta is not None
         if rayleigh and explicit:
-            raise _fail("give either ratios + modes or alpha + beta, not both")
+            raise fail("give either ratios + modes or alpha + beta, not both")
         if rayleigh and (self.ratios is None or self.modes is None):
             missing = "modes" if self.modes is None else "ratios"
-            raise _fail("required key is missing (ratios and modes go together)", missing)
+            raise fail("required key is missing (ratios and modes go together)", missing)
         if explicit and (self.alpha is None or self.beta is None):
             missing = "beta" if self.beta is None else "alpha"
-            raise _fail("required key is missing (alpha and beta go together; write 0.0 for none)", missing)
+            raise fail("required key is missing (alpha and beta go together; write 0.0 for none)", missing)
         if not rayleigh and not explicit:
-            raise _fail("give ratios + modes or alpha + beta (or remove [bridge.damping] for no damping)")
+            raise fail("give ratios + modes or alpha + beta (or remove [bridge.damping] for no damping)")
         return self
 
     def to_damping(self) -> RayleighDamping | ExplicitDamping:
@@ -691,7 +455,7 @@ class DampingConfig(_Model):
         return ExplicitDamping(alpha=self.alpha, beta=self.beta)
 
 
-class BridgeConfig(_Model):
+class BridgeConfig(ConfigModel):
     """``[bridge]``: a straight continuous beam of one or more spans."""
 
     name: Annotated[str, Strict(), Field(min_length=1)] | None = None
@@ -706,7 +470,7 @@ class BridgeConfig(_Model):
     @classmethod
     def _some_spans(cls, value: tuple[float, ...]) -> tuple[float, ...]:
         if not value:
-            raise _fail("expected one or more span lengths, got []")
+            raise fail("expected one or more span lengths, got []")
         return value
 
     @model_validator(mode="after")
@@ -723,7 +487,7 @@ class BridgeConfig(_Model):
                                 f"got {len(self.supports)}")
             )
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return self
 
     @property
@@ -732,49 +496,43 @@ class BridgeConfig(_Model):
         return float(sum(self.spans))
 
 
-class SensorConfig(_Model):
+class SensorConfig(ConfigModel):
     """``[[sensors]]``: a measured quantity at a deck point."""
 
     name: Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
     x: Number
     y: Number = 0.0
-    quantity: Annotated[str, _choice(QUANTITIES, "quantity")] = "displacement"
+    quantity: Annotated[str, choice(QUANTITIES, "quantity")] = "displacement"
 
 
-def _number_problem(item: Any) -> str | None:
-    if isinstance(item, bool) or not isinstance(item, (int, float)):
-        return f"expected a number, got {_describe(item)}"
-    if not math.isfinite(item):
-        return f"must be a finite number (got {_show(item)})"
-    return None
 
 
 def _speed_profile(value: Any) -> tuple[tuple[float, float], ...]:
     """``profile = [[t, v], ...]``: t from entry (s), starting at 0 and increasing; v >= 0 (m/s)."""
     if not isinstance(value, (list, tuple)) or not value:
-        raise _fail(f"expected a non-empty array of [t, v] pairs (s, m/s), got {_describe(value)}")
+        raise fail(f"expected a non-empty array of [t, v] pairs (s, m/s), got {describe(value)}")
     problems: list[tuple[tuple[int, ...], str]] = []
     points: list[tuple[float, float]] = []
     for i, item in enumerate(value):
         if not isinstance(item, (list, tuple)) or len(item) != 2:
-            problems.append(((i,), f"expected a pair [t, v] (s, m/s), got {_describe(item)}"))
+            problems.append(((i,), f"expected a pair [t, v] (s, m/s), got {describe(item)}"))
             continue
-        bad = [((i, j), msg) for j, v in enumerate(item) if (msg := _number_problem(v))]
+        bad = [((i, j), msg) for j, v in enumerate(item) if (msg := number_problem(v))]
         if bad:
             problems.extend(bad)
             continue
         t, v = float(item[0]), float(item[1])
         if i == 0 and t != 0.0:
-            problems.append(((0, 0), f"the first time must be 0 (time from the vehicle's entry; got {_show(item[0])})"))
+            problems.append(((0, 0), f"the first time must be 0 (time from the vehicle's entry; got {show(item[0])})"))
         elif points and t <= points[-1][0]:
             problems.append(
-                ((i, 0), f"times must increase (got {_show(item[0])} after {_show(points[-1][0])})")
+                ((i, 0), f"times must increase (got {show(item[0])} after {show(points[-1][0])})")
             )
         if v < 0:
-            problems.append(((i, 1), f"speed must be >= 0 m/s (got {_show(item[1])})"))
+            problems.append(((i, 1), f"speed must be >= 0 m/s (got {show(item[1])})"))
         points.append((t, v))
     if problems:
-        raise _Problems(problems)
+        raise Problems(problems)
     return tuple(points)
 
 
@@ -783,19 +541,19 @@ SpeedProfile = Annotated[tuple[tuple[float, float], ...], PlainValidator(_speed_
 _CORE_KEY = re.compile(r"`(?P<key>\w+)`\s*(?P<rest>.*)", re.S)
 
 
-def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> _Problems:
+def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> Problems:
     """A core-class message ("quarter-car: `m_v` must be ...") as a problem at that key."""
     match = _CORE_KEY.search(str(exc))
     if match and match["key"] in keys:
-        return _fail(match["rest"].strip(), match["key"])
-    return _fail(str(exc))
+        return fail(match["rest"].strip(), match["key"])
+    return fail(str(exc))
 
 
-class VehicleConfig(_Model):
+class VehicleConfig(ConfigModel):
     """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
 
     id: Annotated[str, Strict(), Field(pattern=_NAME_PATTERN)]
-    model: Annotated[str, _choice(tuple(VEHICLE_MODELS), "vehicle model")]
+    model: Annotated[str, choice(tuple(VEHICLE_MODELS), "vehicle model")]
     mass: Number | None = None
     m_v: Number | None = None
     m_w: Number | None = None
@@ -806,7 +564,7 @@ class VehicleConfig(_Model):
     y: Number
     speed: Positive | None = None
     entry_time: NonNegative = 0.0
-    direction: Annotated[str, _choice(tuple(DIRECTIONS), "direction")] = "+x"
+    direction: Annotated[str, choice(tuple(DIRECTIONS), "direction")] = "+x"
     profile: SpeedProfile | None = None
 
     @model_validator(mode="after")
@@ -816,16 +574,16 @@ class VehicleConfig(_Model):
         listed = ", ".join((*required, *optional))
         for key in VEHICLE_PARAMETERS:
             if getattr(self, key) is not None and key not in required and key not in optional:
-                problems.append(((key,), f"not a parameter of model {_show(self.model)} (its parameters: {listed})"))
+                problems.append(((key,), f"not a parameter of model {show(self.model)} (its parameters: {listed})"))
         for key in required:
             if getattr(self, key) is None:
-                problems.append(((key,), f"required key is missing (model {_show(self.model)} needs {listed})"))
+                problems.append(((key,), f"required key is missing (model {show(self.model)} needs {listed})"))
         if self.speed is not None and self.profile is not None:
             problems.append((("speed",), "give either speed or profile, not both"))
         if self.speed is None and self.profile is None:
             problems.append((("speed",), "required key is missing (give speed, m/s, or a speed profile)"))
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         try:
             self.to_model()
         except ConfigError as exc:
@@ -869,27 +627,27 @@ class VehicleConfig(_Model):
         )
 
 
-class RoadConfig(_Model):
+class RoadConfig(ConfigModel):
     """``[road]``: an ISO 8608 class with a seed, a profile file, or a smooth road."""
 
-    road_class: Annotated[str, _choice(ROAD_CLASSES, "road class")] | None = Field(default=None, alias="class")
+    road_class: Annotated[str, choice(ROAD_CLASSES, "road class")] | None = Field(default=None, alias="class")
     seed: Annotated[int, Strict(), Field(ge=0)] | None = None
     profile: Annotated[str, Strict(), Field(min_length=1)] | None = None
 
     @model_validator(mode="after")
     def _one_form(self) -> RoadConfig:
         if self.road_class is not None and self.profile is not None:
-            raise _fail(f"give either class or profile, not both (got class = {_show(self.road_class)} "
-                        f"and profile = {_show(self.profile)})")
+            raise fail(f"give either class or profile, not both (got class = {show(self.road_class)} "
+                        f"and profile = {show(self.profile)})")
         if self.random and self.seed is None:
-            raise _fail(
-                f"required key is missing: a random road (class = {_show(self.road_class)}) needs a seed "
+            raise fail(
+                f"required key is missing: a random road (class = {show(self.road_class)}) needs a seed "
                 "(an integer >= 0) so that it can be reproduced, e.g. seed = 1", "seed"
             )
         if self.seed is not None and not self.random:
-            where = f"profile = {_show(self.profile)}" if self.profile is not None else (
-                f"class = {_show(self.road_class)}" if self.road_class is not None else "no class")
-            raise _fail(f'only used with a random road, class = "A" ... "H" (got {where})', "seed")
+            where = f"profile = {show(self.profile)}" if self.profile is not None else (
+                f"class = {show(self.road_class)}" if self.road_class is not None else "no class")
+            raise fail(f'only used with a random road, class = "A" ... "H" (got {where})', "seed")
         return self
 
     @property
@@ -903,7 +661,7 @@ class RoadConfig(_Model):
         return not self.random and self.profile is None
 
 
-class TrafficConfig(_Model):
+class TrafficConfig(ConfigModel):
     """``[traffic]``: vehicles from a SUMO simulation (instead of scripted ``[[vehicles]]``)."""
 
     sumo_config: Annotated[str, Strict(), Field(min_length=1)]
@@ -917,9 +675,9 @@ class TrafficConfig(_Model):
     @model_validator(mode="after")
     def _times(self) -> TrafficConfig:
         if self.end <= self.begin:
-            raise _fail(f"must be after begin = {_show(self.begin)} s (got {_show(self.end)})", "end")
+            raise fail(f"must be after begin = {show(self.begin)} s (got {show(self.end)})", "end")
         if self.axis is not None and math.dist(*self.axis) <= 0:
-            raise _fail("the two axis points must differ", "axis")
+            raise fail("the two axis points must differ", "axis")
         return self
 
     @property
@@ -927,13 +685,13 @@ class TrafficConfig(_Model):
         return self.sumo_config in SUMO_LEVELS
 
 
-class SolverConfig(_Model):
+class SolverConfig(ConfigModel):
     """``[solver]``: time integration settings."""
 
     dt: Positive = 0.005
-    scheme: Annotated[str, _choice(SCHEMES, "scheme")] = "newmark"
+    scheme: Annotated[str, choice(SCHEMES, "scheme")] = "newmark"
     hht_alpha: Annotated[float, Strict(), Field(ge=-1.0 / 3.0, le=0.0)] | None = None
-    basis: Annotated[str, _choice(BASES, "basis")] = "direct"
+    basis: Annotated[str, choice(BASES, "basis")] = "direct"
     modes: PositiveInt | None = None
     cutoff_hz: Positive | None = None
     duration: Positive | None = None
@@ -961,9 +719,9 @@ class SolverConfig(_Model):
         if self.basis == "modal" and self.modes is not None and self.cutoff_hz is not None:
             problems.append((("cutoff_hz",), "give either modes or cutoff_hz for the modal basis, not both"))
         if self.duration is not None and self.duration < self.dt:
-            problems.append((("duration",), f"must be >= dt = {_show(self.dt)} s (got {_show(self.duration)})"))
+            problems.append((("duration",), f"must be >= dt = {show(self.dt)} s (got {show(self.duration)})"))
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return self
 
     def to_settings(self) -> SolverSettings:
@@ -979,7 +737,7 @@ class SolverConfig(_Model):
         )
 
 
-class OutputConfig(_Model):
+class OutputConfig(ConfigModel):
     """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, and the logging rate.
 
     The rate is ``rate_hz`` (default :data:`DEFAULT_RATE_HZ`) or, for
@@ -994,12 +752,12 @@ class OutputConfig(_Model):
     @model_validator(mode="after")
     def _one_rate(self) -> OutputConfig:
         if self.rate_hz is not None and self.every is not None:
-            raise _fail(
+            raise fail(
                 f"give either rate_hz (logging rate, Hz) or every (keep every N-th step), not both "
-                f"(got rate_hz = {_show(self.rate_hz)} and every = {self.every})", "every"
+                f"(got rate_hz = {show(self.rate_hz)} and every = {self.every})", "every"
             )
         if self.log is not None and not self.log.lower().endswith(".mcap"):
-            raise _fail(f"the log is an MCAP file: expected a path ending in .mcap (got {_show(self.log)})", "log")
+            raise fail(f"the log is an MCAP file: expected a path ending in .mcap (got {show(self.log)})", "log")
         return self
 
     def decimation(self, dt: float) -> int:
@@ -1036,7 +794,7 @@ def _file_name(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]", "_", text) or "scenario"
 
 
-class Scenario(_Model):
+class Scenario(ConfigModel):
     """A validated scenario: the bridge, its sensors, scripted vehicles, road, solver and output settings.
 
     Build one with :func:`load_scenario` (file or bundled name) or
@@ -1088,20 +846,20 @@ class Scenario(_Model):
             if sensor.name in seen:
                 problems.append(
                     (("sensors", i, "name"),
-                     f"duplicate sensor name {_show(sensor.name)} (also sensors[{seen[sensor.name]}])")
+                     f"duplicate sensor name {show(sensor.name)} (also sensors[{seen[sensor.name]}])")
                 )
             seen.setdefault(sensor.name, i)
             if not -tol_x <= sensor.x <= length + tol_x:
                 problems.append(
-                    (("sensors", i, "x"), f"must lie on the bridge, 0 <= x <= {length:g} m (got {_show(sensor.x)})")
+                    (("sensors", i, "x"), f"must lie on the bridge, 0 <= x <= {length:g} m (got {show(sensor.x)})")
                 )
             if not y_min - tol_y <= sensor.y <= y_max + tol_y:
                 problems.append(
                     (("sensors", i, "y"),
-                     f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {_show(sensor.y)})")
+                     f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {show(sensor.y)})")
                 )
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return self
 
     @model_validator(mode="after")
@@ -1114,14 +872,14 @@ class Scenario(_Model):
             if vehicle.id in seen:
                 problems.append(
                     (("vehicles", i, "id"),
-                     f"duplicate vehicle id {_show(vehicle.id)} (also vehicles[{seen[vehicle.id]}]; "
+                     f"duplicate vehicle id {show(vehicle.id)} (also vehicles[{seen[vehicle.id]}]; "
                      "vehicles without an id are named V1, V2, ... by position)")
                 )
             seen.setdefault(vehicle.id, i)
             if not y_min - tol_y <= vehicle.y <= y_max + tol_y:
                 problems.append(
                     (("vehicles", i, "y"),
-                     f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {_show(vehicle.y)})")
+                     f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {show(vehicle.y)})")
                 )
         if self.vehicles and self.solver.duration is None and not problems:
             length = self.bridge.length
@@ -1138,7 +896,7 @@ class Scenario(_Model):
                     )
                     break
         if problems:
-            raise _Problems(problems)
+            raise Problems(problems)
         return self
 
     @model_validator(mode="after")
@@ -1147,20 +905,20 @@ class Scenario(_Model):
         if traffic is None:
             return self
         if self.vehicles:
-            raise _fail("give either [traffic] (SUMO) or [[vehicles]] (scripted), not both", "traffic")
+            raise fail("give either [traffic] (SUMO) or [[vehicles]] (scripted), not both", "traffic")
         ratio = traffic.step / self.solver.dt
         if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
-            raise _fail(f"SUMO's step must be a whole number of solver steps: step / solver.dt = "
-                        f"{_num(traffic.step)} / {_num(self.solver.dt)} = {ratio:.6g}", "traffic", "step")
+            raise fail(f"SUMO's step must be a whole number of solver steps: step / solver.dt = "
+                        f"{number_text(traffic.step)} / {number_text(self.solver.dt)} = {ratio:.6g}", "traffic", "step")
         length = self.bridge.length
         if traffic.axis is not None and abs(math.dist(*traffic.axis) - length) > 1e-3:
-            raise _fail(f"the axis is {math.dist(*traffic.axis):.6g} m long; it must be the bridge's length, "
+            raise fail(f"the axis is {math.dist(*traffic.axis):.6g} m long; it must be the bridge's length, "
                         f"{length:g} m", "traffic", "axis")
         if not traffic.bundled:
             base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
             path = Path(base) / traffic.sumo_config
             if not path.is_file():
-                raise _fail(f"file not found: {path} (a bundled level: {', '.join(SUMO_LEVELS)}; a relative path "
+                raise fail(f"file not found: {path} (a bundled level: {', '.join(SUMO_LEVELS)}; a relative path "
                             "is relative to the scenario file's folder)", "traffic", "sumo_config")
         return self
 
@@ -1168,8 +926,8 @@ class Scenario(_Model):
     def _rate_within_steps(self) -> Scenario:
         rate, dt = self.output.rate_hz, self.solver.dt
         if rate is not None and rate * dt > 1.0 + 1e-9:
-            raise _fail(
-                f"must be <= 1 / solver.dt = {_num(1.0 / dt)} Hz (got {_show(rate)}): "
+            raise fail(
+                f"must be <= 1 / solver.dt = {number_text(1.0 / dt)} Hz (got {show(rate)}): "
                 "the log samples the solver's steps, it cannot be faster than them", "output", "rate_hz"
             )
         return self
@@ -1181,19 +939,19 @@ class Scenario(_Model):
         base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
         path = Path(base) / self.road.profile
         if not path.is_file():
-            raise _fail(
+            raise fail(
                 f"file not found: {path} (a relative path is relative to the scenario file's folder)",
                 "road", "profile",
             )
         try:
             road = profile_from_csv(path)
         except ConfigError as exc:
-            raise _fail(str(exc), "road", "profile") from None
+            raise fail(str(exc), "road", "profile") from None
         x_end = road.x0 + road.dx * (road.r.shape[1] - 1)
         length = self.bridge.length
         tol = 1e-6 * max(length, 1.0)
         if road.x0 > tol or x_end < length - tol:
-            raise _fail(
+            raise fail(
                 f"{path}: the profile covers {road.x0:g} <= x <= {x_end:g} m; it must cover the deck, "
                 f"0 <= x <= {length:g} m", "road", "profile",
             )
@@ -1347,7 +1105,10 @@ class Scenario(_Model):
         """
         if self.traffic is None:
             return self.build_vehicles()
-        from cosim.sumo.adapter import BridgeAxis, SumoTraffic  # only SUMO runs load libsumo
+        from cosim.sumo.adapter import (  # only SUMO runs load libsumo
+            BridgeAxis,
+            SumoTraffic,
+        )
 
         t = self.traffic
         length = self.bridge.length
@@ -1476,7 +1237,7 @@ def parse_scenario(
         context = {"source": source, "text": text, "base_dir": os.fspath(base_dir)}
         return Scenario.model_validate(data, context=context)
     except ValidationError as exc:
-        raise _config_error(source, Scenario, exc) from None
+        raise config_error(source, Scenario, exc) from None
 
 
 def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
@@ -1508,6 +1269,6 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
     if path.is_dir():
         raise ConfigError(f"{source}: is a directory, expected a scenario .toml file")
     listed = ", ".join(bundled) or "none"
-    hint = _suggest(source, bundled)
+    hint = suggest(source, bundled)
     hint_text = f'; did you mean "{hint}"?' if hint else ""
     raise ConfigError(f"{source}: no such scenario file{hint_text} (bundled scenarios: {listed})")

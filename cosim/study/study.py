@@ -56,18 +56,20 @@ from pydantic import Field, PlainValidator, Strict, ValidationError, field_valid
 from cosim.core.quasistatic import daf, quasi_static
 from cosim.core.roughness import ISO_CLASSES as _ISO
 from cosim.errors import ConfigError, CosimError
-from cosim.log.writer import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, file_is_complete, read_log, traffic_from_log
+from cosim.log.writer import (
+    TOPIC_TRAFFIC,
+    TOPIC_VEHICLE_TYPES,
+    file_is_complete,
+    read_log,
+    traffic_from_log,
+)
 
 ISO_CLASSES = tuple(_ISO)
+from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
 from cosim.run.scenario import (
     ROAD_CLASSES,
     SUMO_LEVELS,
     Scenario,
-    _config_error,
-    _fail,
-    _Model,
-    _Problems,
-    _show,
     list_bundled_scenarios,
     load_scenario,
 )
@@ -138,9 +140,7 @@ _Percent = Annotated[float, Strict(), Field(gt=0.0, le=100.0)]
 
 def _road_class(value: Any) -> str:
     if not isinstance(value, str) or value not in ROAD_CLASSES:
-        from cosim.run.scenario import _choices_message
-
-        raise _fail(_choices_message(value, ROAD_CLASSES, "road class"))
+        raise fail(choices_message(value, ROAD_CLASSES, "road class"))
     return value
 
 
@@ -148,20 +148,20 @@ def _seeds(value: Any) -> tuple[int, ...]:
     """``seeds = [1, 2, 3]`` or a count ``seeds = 3`` (meaning 1, 2, 3)."""
     if isinstance(value, int) and not isinstance(value, bool):
         if value < 1:
-            raise _fail(f"a count of seeds must be >= 1 (got {value})")
+            raise fail(f"a count of seeds must be >= 1 (got {value})")
         return tuple(range(1, value + 1))
     if not isinstance(value, (list, tuple)):
-        raise _fail(f"expected an array of integers >= 0 (or a count), got {_show(value)}")
+        raise fail(f"expected an array of integers >= 0 (or a count), got {show(value)}")
     problems = []
     for i, item in enumerate(value):
         if isinstance(item, bool) or not isinstance(item, int) or item < 0:
-            problems.append(((i,), f"expected an integer >= 0, got {_show(item)}"))
+            problems.append(((i,), f"expected an integer >= 0, got {show(item)}"))
     if problems:
-        raise _Problems(problems)
+        raise Problems(problems)
     return tuple(value)
 
 
-class StudySection(_Model):
+class StudySection(ConfigModel):
     """``[study]``: what to run and where the results go."""
 
     name: _NAME | None = None
@@ -172,7 +172,7 @@ class StudySection(_Model):
     plots: Annotated[bool, Strict()] = True
 
 
-class SweepSection(_Model):
+class SweepSection(ConfigModel):
     """``[sweep]``: the axes; every combination of their values is one run."""
 
     sumo_config: tuple[_Text, ...] | None = None
@@ -188,16 +188,16 @@ class SweepSection(_Model):
         if value is None:
             return value
         if len(value) == 0:
-            raise _fail("expected at least one value (remove the key to keep the base scenario's)")
+            raise fail("expected at least one value (remove the key to keep the base scenario's)")
         seen: dict[Any, int] = {}
         for i, item in enumerate(value):
             if item in seen:
-                raise _fail(f"value {_show(item)} is listed twice (at {seen[item]} and {i})")
+                raise fail(f"value {show(item)} is listed twice (at {seen[item]} and {i})")
             seen[item] = i
         return value
 
 
-class StudyFile(_Model):
+class StudyFile(ConfigModel):
     study: StudySection
     sweep: SweepSection = SweepSection()
 
@@ -631,7 +631,7 @@ def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[
     try:
         parsed = StudyFile.model_validate(raw)
     except ValidationError as exc:
-        raise _config_error(source, StudyFile, exc) from None
+        raise config_error(source, StudyFile, exc) from None
     study_dir = Path(base_dir)
     sec = parsed.study
     base_path = study_dir / sec.base
