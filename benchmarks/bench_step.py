@@ -62,9 +62,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 import numba  # noqa: E402
 
 from cosim.core import kernels  # noqa: E402
+from cosim.core.bases import make_basis  # noqa: E402
 from cosim.core.bridge import BridgeModel, ExplicitDamping, build_bridge  # noqa: E402
 from cosim.core.coupling import CoupledSystem  # noqa: E402
-from cosim.core.integrator import Scheme, make_basis  # noqa: E402
+from cosim.core.schemes import Scheme  # noqa: E402
+from cosim.core.sensors import Sensor  # noqa: E402
 from cosim.core.traffic import TrafficBlock  # noqa: E402
 from cosim.core.vehicles import MovingForce, QuarterCar, VehicleModel  # noqa: E402
 from cosim.run.scenario import load_scenario  # noqa: E402
@@ -268,7 +270,7 @@ def cosim_factory(bridge: BridgeModel, basis: str, n_modes: int | None = None, c
     """
     scheme = Scheme.newmark()
     b = make_basis(bridge, DT, scheme, basis, n_modes, cutoff_hz)
-    sensors = ((bridge.length / 2, sensor_y, "displacement"),)
+    sensors = (Sensor("mid", bridge.length / 2, sensor_y, "displacement"),)
     return (lambda: CoupledSystem(bridge, b, scheme, DT, sensors=sensors)), b.n
 
 

@@ -356,7 +356,7 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
     vehicles = {}
     for vid in result.vehicle_ids:
         v = result.vehicle(vid)
-        vehicles[vid] = {"t": v["t"], "x": v["x"], "y": v["y"], "speed": v["v"], "contact_force": v["contact_force"],
+        vehicles[vid] = {"t": v["t"], "x": v["x"], "y": v["y"], "speed": v["speed"], "contact_force": v["contact_force"],
                          "body_displacement": v["body_displacement"], "body_acceleration": v["body_acceleration"]}
     return Results(
         scenario=sc, t=result.t, channels=dict(result.sensors),

@@ -12,7 +12,7 @@ with ``p_i = c0 n0 + c1 n1 + c2 n2`` a combination of the contact rows
 (bending and twist: ``w = w_S + (y - y_S) theta_x``). The wheel of the
 rigid-contact quarter-car follows the deck, and its acceleration is
 differentiated honestly for a vehicle with speed ``v`` and acceleration
-``a_v`` (DESIGN.md section 4)::
+``a_v`` (docs/theory.md §5.2)::
 
     u_w'' = n0 d'' + 2 v n1 d' + (v^2 n2 + a_v n1) d
 
@@ -29,29 +29,36 @@ itself runs compiled (:mod:`cosim.core.kernels`).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from cosim.errors import ModelError
+from cosim.errors import ConfigError, ModelError
 
 from . import kernels
+from .bases import DirectBasis, ModalBasis
 from .bridge import BridgeModel
-from .integrator import DirectBasis, ModalBasis, Scheme
+from .element import DECK_POINT_DOFS, NODE_DOFS
 from .roughness import RoadProfile, smooth_road
+from .schemes import Scheme
+from .sensors import TIME_DERIVATIVE, Sensor, check_sensor_on, sensor_row
 from .traffic import TrafficBlock, TrafficFrame
-from .vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from .vehicles import MODELS, PARAM_ROWS, STATE_ROWS, VehicleModel
 
-SENSOR_KIND = {"displacement": 0, "velocity": 1, "acceleration": 2, "bending_moment": 0}
+#: Lateral tolerance of "on the deck" for a wheel path, relative to the deck width.
+_Y_TOL = 1e-9
 
 
-@dataclass
+@dataclass(frozen=True)
 class BlockReport:
     """What the vehicles did over a block of K steps (arrays (K, q) over the block's vehicles).
 
     ``on_deck`` says where a vehicle was on the deck; contact forces (N,
-    compression positive) are zero elsewhere; ``sensors`` is (K, s).
+    compression positive) are zero elsewhere; ``lifted`` marks the steps where
+    a wheel on the deck pulled (negative contact force: lift-off, counted by the
+    compiled loop); ``sensors`` is (K, s).
     """
 
     ids: tuple[str, ...]
@@ -65,25 +72,25 @@ class BlockReport:
     body_displacement: npt.NDArray[np.float64]
     body_acceleration: npt.NDArray[np.float64]
     sensors: npt.NDArray[np.float64]
+    lifted: npt.NDArray[np.bool_]
 
 
-def _model_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+def _fleet_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray,
+                                                                                          np.ndarray]:
+    """Compiled kind, parameters (PARAM_ROWS, q) and total mass (q,) of the vehicles."""
     q = len(models)
     kind = np.empty(q, dtype=np.int64)
-    params = np.zeros((7, q))  # m_v, m_w, k_v, c_v, k_t, c_t, total mass
+    params = np.zeros((PARAM_ROWS, q))
+    mass = np.empty(q)
     for j, m in enumerate(models):
-        if isinstance(m, MovingForce):
-            kind[j] = kernels.MOVING_FORCE
-        elif isinstance(m, QuarterCar):
-            kind[j] = kernels.QUARTER_CAR
-            params[:4, j] = m.m_v, m.m_w, m.k_v, m.c_v
-        elif isinstance(m, TyreQuarterCar):
-            kind[j] = kernels.TYRE_QUARTER_CAR
-            params[:6, j] = m.m_v, m.m_w, m.k_v, m.c_v, m.k_t, m.c_t
-        else:
-            raise ModelError(f"vehicle {ids[j]}: unknown vehicle model {type(m).__name__}")
-        params[6, j] = m.total_mass
-    return kind, params
+        if type(m) not in MODELS.values():
+            raise ConfigError(f"vehicle {ids[j]}: unknown vehicle model {type(m).__name__} "
+                              f"(expected one of: {', '.join(MODELS)})")
+        kind[j] = m.KIND
+        packed = m.pack()
+        params[: len(packed), j] = packed
+        mass[j] = m.total_mass
+    return kind, params, mass
 
 
 class CoupledSystem:
@@ -96,7 +103,12 @@ class CoupledSystem:
         dt: time step, s.
         road: road profiles (default smooth).
         gravity: m/s^2.
-        sensors: ``(x, y, quantity)`` triples sampled at every step.
+        sensors: the sensors sampled at every step (on the deck).
+
+    Raises:
+        ConfigError: a basis built for another bridge, time step or scheme; a
+            sensor off the deck; later, in :meth:`advance`, a vehicle whose wheel
+            path lies off the deck.
     """
 
     def __init__(
@@ -107,50 +119,71 @@ class CoupledSystem:
         dt: float,
         road: RoadProfile | None = None,
         gravity: float = 9.81,
-        sensors: tuple[tuple[float, float, str], ...] = (),
+        sensors: tuple[Sensor, ...] = (),
     ) -> None:
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise ConfigError(f"`dt` must be a finite number > 0 s (got {dt!r})")
+        if not (isinstance(gravity, (int, float)) and math.isfinite(gravity) and gravity >= 0):
+            raise ConfigError(f"`gravity` must be a finite number >= 0 m/s^2 (got {gravity!r})")
+        if basis.bridge is not bridge:
+            raise ConfigError("the basis was built for another bridge model: build it with this bridge (make_basis)")
+        if (basis.dt, basis.scheme) != (float(dt), scheme):
+            raise ConfigError(f"the basis was built for dt = {basis.dt} s and scheme {basis.scheme.name}; "
+                              f"build it for dt = {dt} s and scheme {scheme.name} (make_basis)")
+        for sensor in sensors:
+            check_sensor_on(bridge, sensor)
         self.bridge, self.basis, self.scheme, self.dt = bridge, basis, scheme, float(dt)
         self.road = road if road is not None else smooth_road()
         self.gravity = float(gravity)
         n = basis.n
         self.t = 0.0
-        self.d, self.v, self.a = np.zeros(n), np.zeros(n), np.zeros(n)
-        self._force = np.zeros(n)  # F_n: non-inertial deck forces of the last step (HHT)
+        self._state = kernels.BridgeState(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
         self.n_steps = 0
         self._counters = np.zeros(4, dtype=np.int64)  # lift-off events, lift-off steps, solves, diverged
         c_w, c_t, _ = bridge._deck_coefficients
-        self._geometry = (bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
-                          float(bridge.section.y_s), float(bridge.length))
+        self._deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
+                                        float(bridge.section.y_s), float(bridge.length),
+                                        np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS)
+        self._scheme = kernels.StepScheme(self.dt, scheme.beta, scheme.gamma, scheme.alpha)
+        self._basis = basis.kernel_arrays()
+        self._y_range = bridge.section.deck_y
         # Fleet (structure of arrays).
         self.ids: tuple[str, ...] = ()
         self._kind = np.zeros(0, dtype=np.int64)
-        self._params = np.zeros((7, 0))
-        self._vstate = np.zeros((8, 0))
+        self._params = np.zeros((PARAM_ROWS, 0))
+        self._mass = np.zeros(0)
+        self._vstate = np.zeros((STATE_ROWS, 0))
         self._lifted = np.zeros(0, dtype=bool)
-        self._set_sensors(sensors)
+        self.sensors = tuple(sensors)
+        idx, vals = basis.sparse_rows([sensor_row(bridge, s) for s in self.sensors])
+        order = np.array([TIME_DERIVATIVE[s.quantity] for s in self.sensors], dtype=np.int64)
+        self._sensor_rows = kernels.SensorRows(idx, vals, order)
 
     # ------------------------------------------------------------ bookkeeping
     @property
+    def d(self) -> npt.NDArray[np.float64]:
+        """Bridge displacements in the basis' coordinates (m, rad)."""
+        return self._state.d
+
+    @property
+    def v(self) -> npt.NDArray[np.float64]:
+        """Bridge velocities in the basis' coordinates."""
+        return self._state.v
+
+    @property
+    def a(self) -> npt.NDArray[np.float64]:
+        """Bridge accelerations in the basis' coordinates."""
+        return self._state.a
+
+    @property
     def liftoff_events(self) -> int:
+        """How many times a wheel on the deck started to pull (contact force < 0)."""
         return int(self._counters[0])
 
     @property
     def liftoff_steps(self) -> int:
+        """Vehicle-steps with a negative contact force on the deck."""
         return int(self._counters[1])
-
-    def _set_sensors(self, sensors: tuple[tuple[float, float, str], ...]) -> None:
-        self._sens_kind = np.array([SENSOR_KIND[qty] for _, _, qty in sensors], dtype=np.int64)
-        rows = [
-            self.bridge.field_row("bending_moment" if qty == "bending_moment" else "w_deck", x, y)
-            for x, y, qty in sensors
-        ]
-        if isinstance(self.basis, DirectBasis):
-            idx = np.array([self.basis.reduced_index(r.dofs) for r in rows], dtype=np.int64).reshape(-1, 14)
-            vals = np.array([r.values[0] for r in rows]).reshape(-1, 14)
-            self._sens = (idx, vals)
-        else:
-            dense = np.array([self.basis.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows])
-            self._sens = (dense.reshape(len(rows), self.basis.n),)
 
     def energy(self) -> float:
         """Bridge kinetic + strain energy, J."""
@@ -158,24 +191,39 @@ class CoupledSystem:
 
     def set_state(self, d: np.ndarray, v: np.ndarray, a: np.ndarray | None = None) -> None:
         """Set the bridge state in reduced coordinates (``a`` defaults to zero)."""
-        self.d, self.v = np.array(d, dtype=float), np.array(v, dtype=float)
-        self.a = np.zeros_like(self.d) if a is None else np.array(a, dtype=float)
+        n = self.basis.n
+        values = [np.array(d, dtype=float), np.array(v, dtype=float),
+                  np.zeros(n) if a is None else np.array(a, dtype=float)]
+        for name, value in zip(("d", "v", "a"), values):
+            if value.shape != (n,) or not np.all(np.isfinite(value)):
+                raise ConfigError(f"`{name}` must be {n} finite numbers (the basis' unknowns)")
+        self._state = kernels.BridgeState(*values, self._state.force)
 
     def _deck_w(self, x: float, y: float) -> float:
-        if not 0.0 <= x <= self.bridge.length:
+        if not kernels.on_deck(x, self.bridge.length):
             return 0.0
         row = self.bridge.deck_point_row(x, y)
         return float(self.basis.reduce_rows(row.dofs[None, :], row.values[:1])[0] @ self.d)
+
+    def _check_paths(self, block: TrafficBlock) -> None:
+        y_min, y_max = self._y_range
+        tol = _Y_TOL * max(y_max - y_min, 1.0)
+        bad = np.flatnonzero(~((block.y >= y_min - tol) & (block.y <= y_max + tol)))
+        if len(bad):
+            j = int(bad[0])
+            raise ConfigError(f"vehicle {block.ids[j]}: its wheel path y = {block.y[j]:g} m lies off the deck "
+                              f"({y_min:g} <= y <= {y_max:g} m); put it on a lane of this bridge")
 
     def _sync(self, block: TrafficBlock) -> None:
         """Match the fleet to the block's vehicles; newcomers stand at static equilibrium."""
         if block.ids == self.ids:
             return
+        self._check_paths(block)
         old = {vid: i for i, vid in enumerate(self.ids)}
         q = len(block.ids)
-        vstate = np.zeros((8, q))
+        vstate = np.zeros((STATE_ROWS, q))
         lifted = np.zeros(q, dtype=bool)
-        kind, params = _model_parameters(block.models, block.ids)
+        kind, params, mass = _fleet_parameters(block.models, block.ids)
         for j, vid in enumerate(block.ids):
             if vid in old:
                 vstate[:, j] = self._vstate[:, old[vid]]
@@ -185,42 +233,30 @@ class CoupledSystem:
                 r0, _ = self.road.evaluate(np.array([y0]), np.array([x0]))
                 level = float(r0[0]) + self._deck_w(x0, y0)
                 vstate[0, j] = vstate[3, j] = level
-        self.ids, self._kind, self._params, self._vstate, self._lifted = block.ids, kind, params, vstate, lifted
+        self.ids, self._kind, self._params, self._mass = block.ids, kind, params, mass
+        self._vstate, self._lifted = vstate, lifted
 
     # ------------------------------------------------------------------ steps
     def advance(self, block: TrafficBlock) -> BlockReport:
-        """Advance ``K = len(block.x)`` steps; row k of the block is the traffic at ``t + (k+1) dt``."""
+        """Advance ``K = len(block.x)`` steps; row k of the block is the traffic at ``t + (k+1) dt``.
+
+        Raises:
+            ConfigError: a vehicle's wheel path off the deck, or an unknown model.
+            ModelError: the solution diverged (non-finite bridge acceleration).
+        """
         self._sync(block)
         K, q = block.x.shape
         y = np.ascontiguousarray(block.y, dtype=float)
         r, r_x = self.road.evaluate(np.broadcast_to(y, (K, q)), block.x)
-        out_sens = np.zeros((K, len(self._sens_kind)))
-        out_contact = np.zeros((K, q))
-        out_bu = np.zeros((K, q))
-        out_ba = np.zeros((K, q))
-        out_on = np.zeros((K, q), dtype=np.bool_)
-        m_v, m_w, k_v, c_v, k_t, c_t, mass = self._params
-        weight = mass * self.gravity
-        sc = self.scheme
-        common = (sc.beta, sc.gamma, sc.alpha)
-        fleet = (self._kind, m_v, m_w, k_v, c_v, k_t, c_t, weight, self._vstate, self._lifted,
-                 np.ascontiguousarray(block.x, dtype=float), np.ascontiguousarray(block.v, dtype=float),
-                 np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x))
-        outputs = (out_sens, out_contact, out_bu, out_ba, out_on, self._counters)
+        out = kernels.BlockOutputs(
+            np.zeros((K, len(self.sensors))), np.zeros((K, q)), np.zeros((K, q)), np.zeros((K, q)),
+            np.zeros((K, q), dtype=np.bool_), np.zeros((K, q), dtype=np.bool_), self._counters)
+        fleet = kernels.Fleet(self._kind, self._params, self._mass * self.gravity, self._vstate, self._lifted)
+        kin = kernels.Kinematics(
+            np.ascontiguousarray(block.x, dtype=float), np.ascontiguousarray(block.v, dtype=float),
+            np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x))
         self._counters[3] = 0
-        if isinstance(self.basis, DirectBasis):
-            b = self.basis
-            kernels.direct_block(
-                b.cholesky_rows, b.K.indptr, b.K.indices, b.K.data, b.M.indptr, b.M.indices, b.M.data,
-                b.ray_alpha, b.ray_beta, b.inverse, b.reduced_map,
-                *self._geometry, self.dt, *common, self.d, self.v, self.a, self._force,
-                *fleet, *self._sens, self._sens_kind, *outputs)
-        else:
-            b = self.basis
-            kernels.modal_block(
-                b.phi_full, b.c_diag, b.k_diag, b.a_inv_diag,
-                *self._geometry, self.dt, *common, self.d, self.v, self.a, self._force,
-                *fleet, *self._sens, self._sens_kind, *outputs)
+        kernels.advance_block(self._basis, self._deck, self._scheme, self._state, fleet, kin, self._sensor_rows, out)
         self.basis.n_solves = int(self._counters[2])
         if self._counters[3]:
             k = int(self._counters[3])
@@ -229,8 +265,8 @@ class CoupledSystem:
             raise ModelError(f"the solution diverged at t = {self.t:.6g} s (non-finite bridge acceleration)")
         self.t += K * self.dt
         self.n_steps += K
-        return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out_on, out_contact, out_bu,
-                           out_ba, out_sens)
+        return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
+                           out.body_u, out.body_a, out.sensors, out.lifted)
 
     def step(self, frame: TrafficFrame) -> BlockReport:
         """Advance one step; ``frame`` describes the vehicles at ``t + dt``."""

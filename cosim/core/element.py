@@ -55,6 +55,12 @@ DOF_NAMES: tuple[str, ...] = ("u", "v", "w", "theta_x", "theta_y", "theta_z", "p
 DOF_INDEX: dict[str, int] = {name: i for i, name in enumerate(DOF_NAMES)}
 NODE_DOFS = 7
 ELEMENT_DOFS = 14
+#: Per node, the DOFs a deck point's vertical displacement w_S + (y - y_S) theta_x depends on: w and, through
+#: the interdependent Timoshenko interpolation, theta_y; theta_x and, through its Hermite interpolation, psi.
+DECK_POINT_NODE_DOFS: tuple[str, ...] = ("w", "theta_x", "theta_y", "psi")
+#: The same as element DOF indices (both nodes), ascending.
+DECK_POINT_DOFS: tuple[int, ...] = tuple(sorted(
+    node * NODE_DOFS + DOF_INDEX[name] for node in (0, 1) for name in DECK_POINT_NODE_DOFS))
 
 # Field rows of the interpolation matrix (all fields are cubic polynomials in xi).
 FIELD_NAMES: tuple[str, ...] = ("u", "v", "w", "theta_x", "theta_y", "theta_z")

@@ -30,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .bridge import BridgeModel
-from .simulation import Sensor
+from .sensors import Sensor, sensor_row
 from .traffic import TrafficSource, vehicle_of
 
 #: Sensor quantities that have a quasi-static response (and hence a DAF).
@@ -47,8 +47,7 @@ def influence_vectors(bridge: BridgeModel, sensors: Sequence[Sensor]) -> npt.NDA
     for i, sensor in enumerate(sensors):
         if sensor.quantity not in STATIC_QUANTITIES:
             continue
-        name = "bending_moment" if sensor.quantity == "bending_moment" else "w_deck"
-        row = bridge.field_row(name, sensor.x, sensor.y)
+        row = sensor_row(bridge, sensor)
         f = np.zeros(bridge.ndof)
         np.add.at(f, row.dofs, row.values[0])
         out[i] = bridge.static(f=f).d

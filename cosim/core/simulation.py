@@ -3,55 +3,55 @@
 :func:`simulate` drives a :class:`~cosim.core.coupling.CoupledSystem` with any
 traffic source and samples the sensors (deck displacement, velocity,
 acceleration including the twist contribution, bending moment) and every
-vehicle (contact force, body displacement and acceleration).
+vehicle (the fields of :data:`cosim.core.fields.VEHICLE_FIELDS`). It checks
+its inputs as a scenario file is checked: a traffic source made for a bridge
+of another length, a road that does not cover the deck, a sensor or a wheel
+path off the deck, or a non-finite setting are errors that name the culprit.
 """
 from __future__ import annotations
 
 import csv
+import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Protocol, Sequence
+from typing import Any, Callable, Protocol, Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from cosim.errors import ConfigError
 
+from .bases import make_basis
 from .bridge import BridgeModel
 from .coupling import BlockReport, CoupledSystem
-from .integrator import Scheme, make_basis
+from .fields import VEHICLE_NUMBERS
 from .roughness import RoadProfile
+from .schemes import Scheme
+from .sensors import Sensor
 from .traffic import TrafficBlock, TrafficSource, vehicle_of
 
-SENSOR_QUANTITIES = ("displacement", "velocity", "acceleration", "bending_moment")
+SCHEMES: tuple[str, ...] = ("newmark", "hht")
+BASES: tuple[str, ...] = ("direct", "modal")
+#: Columns of :attr:`SimulationResult.vehicle_table`: the sample time, the vehicle's index, its fields.
+VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
 
-@dataclass(frozen=True)
-class Sensor:
-    """A virtual sensor on the deck.
-
-    Args:
-        name: channel name.
-        x, y: position on the deck, m (y is ignored for the bending moment).
-        quantity: displacement (m) | velocity (m/s) | acceleration (m/s^2) of
-            the deck point, vertical, twist included; or bending_moment (N m,
-            sagging positive) of the section at x.
-    """
-
-    name: str
-    x: float
-    y: float = 0.0
-    quantity: str = "displacement"
-
-    def __post_init__(self) -> None:
-        if self.quantity not in SENSOR_QUANTITIES:
-            raise ConfigError(f"sensor {self.name}: `quantity` must be one of {', '.join(SENSOR_QUANTITIES)}")
+def _finite(owner: str, key: str, value: Any, low: float, inclusive: bool = False) -> None:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and (
+        value >= low if inclusive else value > low)
+    if not ok:
+        raise ConfigError(f"{owner}`{key}` must be a finite number {'>=' if inclusive else '>'} {low:g} "
+                          f"(got {value!r})")
 
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """Time step (s), scheme, basis and modal truncation."""
+    """Time step (s), scheme (newmark | hht), basis (direct | modal) and modal truncation; gravity, m/s^2.
+
+    Raises:
+        ConfigError: a non-finite or non-physical value, or an unknown scheme or basis.
+    """
 
     dt: float = 0.005
     scheme: str = "newmark"
@@ -61,30 +61,41 @@ class SolverSettings:
     cutoff_hz: float | None = None
     gravity: float = 9.81
 
+    def __post_init__(self) -> None:
+        _finite("", "dt", self.dt, 0.0)
+        _finite("", "gravity", self.gravity, 0.0, inclusive=True)
+        if self.scheme not in SCHEMES:
+            raise ConfigError(f"`scheme` must be one of {', '.join(SCHEMES)} (got {self.scheme!r})")
+        if self.basis not in BASES:
+            raise ConfigError(f"`basis` must be one of {', '.join(BASES)} (got {self.basis!r})")
+        if self.modes is not None and (isinstance(self.modes, bool) or not isinstance(self.modes, int)
+                                       or self.modes < 1):
+            raise ConfigError(f"`modes` must be an integer >= 1 (got {self.modes!r})")
+        if self.cutoff_hz is not None:
+            _finite("", "cutoff_hz", self.cutoff_hz, 0.0)
+
     def make_scheme(self) -> Scheme:
-        if self.scheme == "newmark":
-            return Scheme.newmark()
-        if self.scheme == "hht":
-            return Scheme.hht(self.hht_alpha)
-        raise ConfigError(f"`scheme` must be 'newmark' or 'hht' (got {self.scheme!r})")
+        """The :class:`~cosim.core.schemes.Scheme` named by ``scheme``."""
+        return Scheme.hht(self.hht_alpha) if self.scheme == "hht" else Scheme.newmark()
 
 
-@dataclass
+@dataclass(frozen=True)
 class SimulationResult:
     """Time histories of a run, as numpy arrays with names.
 
     Attributes:
         t: sample times, s.
         sensors: sensor name -> samples (unit of its quantity).
-        vehicle_ids: every vehicle that was on the deck.
-        vehicle_table: long-format vehicle samples, column name -> array; one
-            row per vehicle on the deck per sample: ``t``, ``vehicle`` (index
-            into ``vehicle_ids``), ``x``, ``y``, ``v``, ``contact_force`` (N,
-            compression positive), ``body_displacement`` (m),
-            ``body_acceleration`` (m/s^2).
+        vehicle_ids: every vehicle (contact point) that was on the deck.
+        vehicle_table: long-format vehicle samples, column name -> array
+            (:data:`VEHICLE_COLUMNS`); one row per vehicle on the deck per
+            sample: ``t``, ``vehicle`` (index into ``vehicle_ids``) and the
+            fields of :data:`cosim.core.fields.VEHICLE_FIELDS` (``x``, ``y``,
+            ``speed``, ``acceleration``, ``body_displacement``,
+            ``body_acceleration``, ``contact_force``; SI units).
         liftoff_events: how many times a wheel's contact force turned negative.
         liftoff_steps: vehicle-steps with a negative contact force.
-        factorizations: effective-matrix factorisations done (1 per run).
+        factorizations: effective-matrix factorisations done (counted by the basis; 1 per run).
         steps: time steps taken; wall_time: s.
         sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
         contact_force_range: (min, max) contact force per vehicle while on the deck, N.
@@ -137,7 +148,7 @@ class BlockObserver(Protocol):
 class _Collector:
     """Accumulates the sampled histories into a :class:`SimulationResult` (memory grows with the run)."""
 
-    COLUMNS = ("t", "vehicle", "x", "y", "v", "contact_force", "body_displacement", "body_acceleration")
+    COLUMNS = VEHICLE_COLUMNS
 
     def __init__(self, n_sensors: int) -> None:
         self.t_parts = [np.zeros(1)]  # sample 0: at rest
@@ -157,15 +168,15 @@ class _Collector:
                 self.vehicle_ids.append(vid)
         rows, cols = np.nonzero(report.on_deck & keep[:, None])
         vidx = np.array([self.index_of[v] for v in report.ids], dtype=np.int64)
-        tab = self.table
-        tab["t"].append(times[rows])
-        tab["vehicle"].append(vidx[cols].astype(float))
-        tab["x"].append(report.x[rows, cols])
-        tab["y"].append(report.y[cols])
-        tab["v"].append(report.v[rows, cols])
-        tab["contact_force"].append(report.contact_force[rows, cols])
-        tab["body_displacement"].append(report.body_displacement[rows, cols])
-        tab["body_acceleration"].append(report.body_acceleration[rows, cols])
+        values = {
+            "t": times[rows], "vehicle": vidx[cols].astype(float), "x": report.x[rows, cols], "y": report.y[cols],
+            "speed": report.v[rows, cols], "acceleration": report.a[rows, cols],
+            "body_displacement": report.body_displacement[rows, cols],
+            "body_acceleration": report.body_acceleration[rows, cols],
+            "contact_force": report.contact_force[rows, cols],
+        }
+        for name in self.COLUMNS:
+            self.table[name].append(values[name])
 
 
 class _Extremes:
@@ -200,6 +211,30 @@ class _Extremes:
             lo_hi[1] = max(lo_hi[1], float(masked_max[j]))
 
 
+def check_traffic_fits(bridge: BridgeModel, traffic: TrafficSource) -> None:
+    """Raise :class:`ConfigError` when a traffic source was made for a bridge of another length.
+
+    Scripted vehicles and replayed frames know the deck length they move on
+    (``traffic.length``): on another bridge their entry and exit times, and so
+    the loading, would silently be wrong.
+    """
+    length = getattr(traffic, "length", None)
+    if length is None:
+        return
+    if not abs(float(length) - bridge.length) <= 1e-9 * max(bridge.length, 1.0):
+        raise ConfigError(f"the traffic was made for a bridge {float(length):g} m long, this one is "
+                          f"{bridge.length:g} m: build the traffic with length = {bridge.length:g}")
+
+
+def check_road_covers(bridge: BridgeModel, road: RoadProfile) -> None:
+    """Raise :class:`ConfigError` unless the road profile covers the deck, 0 <= x <= L."""
+    x_end = road.x0 + road.dx * (road.r.shape[1] - 1)
+    tol = 1e-6 * max(bridge.length, 1.0)
+    if road.x0 > tol or x_end < bridge.length - tol:
+        raise ConfigError(f"the road profile ({road.description}) covers {road.x0:g} <= x <= {x_end:g} m; "
+                          f"it must cover the deck, 0 <= x <= {bridge.length:g} m")
+
+
 def simulate(
     bridge: BridgeModel,
     traffic: TrafficSource,
@@ -229,16 +264,24 @@ def simulate(
         collect: keep the sampled histories in the result; without it memory
             stays constant however long the run (extremes are still reported).
     """
-    if not duration > 0:
-        raise ConfigError(f"`duration` must be > 0 s (got {duration})")
-    if output_every < 1:
-        raise ConfigError("`output_every` must be >= 1")
+    _finite("", "duration", duration, 0.0)
+    if duration < solver.dt:
+        raise ConfigError(f"`duration` must be at least one time step, dt = {solver.dt:g} s (got {duration!r})")
+    if isinstance(output_every, bool) or not isinstance(output_every, int) or output_every < 1:
+        raise ConfigError(f"`output_every` must be an integer >= 1 (got {output_every!r})")
+    if isinstance(block_steps, bool) or not isinstance(block_steps, int) or block_steps < 1:
+        raise ConfigError(f"`block_steps` must be an integer >= 1 (got {block_steps!r})")
+    names = [s.name for s in sensors]
+    duplicated = sorted({n for n in names if names.count(n) > 1})
+    if duplicated:
+        raise ConfigError(f"sensor names must be unique (got {', '.join(duplicated)} more than once)")
+    check_traffic_fits(bridge, traffic)
+    if road is not None:
+        check_road_covers(bridge, road)
     scheme = solver.make_scheme()
     basis = make_basis(bridge, solver.dt, scheme, solver.basis, solver.modes, solver.cutoff_hz)
-    system = CoupledSystem(
-        bridge, basis, scheme, solver.dt, road=road, gravity=solver.gravity,
-        sensors=tuple((s.x, s.y, s.quantity) for s in sensors),
-    )
+    system = CoupledSystem(bridge, basis, scheme, solver.dt, road=road, gravity=solver.gravity,
+                           sensors=tuple(sensors))
     n_steps = int(round(duration / solver.dt))
     collector = _Collector(len(sensors)) if collect else None
     extremes = _Extremes([s.name for s in sensors])

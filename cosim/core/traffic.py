@@ -9,6 +9,7 @@ gone. :class:`ScriptedTraffic` is the source for runs without SUMO.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -17,9 +18,19 @@ import numpy.typing as npt
 
 from cosim.errors import ConfigError
 
-from .vehicles import VehicleModel
+from .vehicles import MODELS, VehicleModel
 
 AXLE_SEPARATOR = "#"
+
+
+def on_deck(x, length):  # noqa: ANN001, ANN201 - scalars or arrays; also compiled as is by cosim.core.kernels
+    """The one rule for "on the deck": a contact point at ``0 <= x <= length`` (m) along the axis.
+
+    Off the deck a vehicle rides on rigid ground and loads nothing. The block
+    loop compiles this very function; traffic sources use it to decide which
+    vehicles a block of steps carries.
+    """
+    return (x >= 0.0) & (x <= length)
 
 
 def vehicle_of(contact_id: str) -> str:
@@ -102,6 +113,15 @@ class ScriptedVehicle:
     profile: tuple[tuple[float, float], ...] = ()
 
     def __post_init__(self) -> None:
+        if not isinstance(self.id, str) or not self.id:
+            raise ConfigError(f"vehicle {self.id!r}: `id` must be a non-empty string")
+        if type(self.model) not in MODELS.values():
+            raise ConfigError(f"vehicle {self.id}: `model` must be one of the vehicle models "
+                              f"({', '.join(c.__name__ for c in MODELS.values())}), got {type(self.model).__name__}")
+        for key in ("y", "speed", "entry_time"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ConfigError(f"vehicle {self.id}: `{key}` must be a finite number (got {value!r})")
         if self.direction not in (1, -1):
             raise ConfigError(f"vehicle {self.id}: `direction` must be +1 or -1 (got {self.direction!r})")
         if not self.profile and not self.speed > 0:
@@ -109,6 +129,9 @@ class ScriptedVehicle:
         if self.entry_time < 0:
             raise ConfigError(f"vehicle {self.id}: `entry_time` must be >= 0 s (got {self.entry_time!r})")
         if self.profile:
+            if not all(len(p) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                           and math.isfinite(v) for v in p) for p in self.profile):
+                raise ConfigError(f"vehicle {self.id}: `profile` must be (t, speed) pairs of finite numbers")
             ts = [p[0] for p in self.profile]
             if ts[0] != 0.0 or any(b <= a for a, b in zip(ts, ts[1:])):
                 raise ConfigError(f"vehicle {self.id}: `profile` times must start at 0 and increase")
@@ -140,9 +163,16 @@ class ScriptedTraffic:
     _ids: frozenset = field(init=False, repr=False, default=frozenset())
 
     def __post_init__(self) -> None:
+        if isinstance(self.length, bool) or not isinstance(self.length, (int, float)) or \
+                not (math.isfinite(self.length) and self.length > 0):
+            raise ConfigError(f"`length` must be the bridge's length, a finite number > 0 m (got {self.length!r})")
+        for v in self.vehicles:
+            if not isinstance(v, ScriptedVehicle):
+                raise ConfigError(f"`vehicles` must be ScriptedVehicle objects (got {type(v).__name__})")
         ids = [v.id for v in self.vehicles]
-        if len(set(ids)) != len(ids):
-            raise ConfigError("vehicle ids must be unique")
+        repeated = sorted({i for i in ids if ids.count(i) > 1})
+        if repeated:
+            raise ConfigError(f"vehicle ids must be unique (got {', '.join(repeated)} more than once)")
         object.__setattr__(self, "_ids", frozenset(ids))
 
     def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock:
@@ -156,7 +186,8 @@ class ScriptedTraffic:
             s[:, j], v[:, j], a[:, j] = veh.distance(times - veh.entry_time)
         entered = times[:, None] >= np.array([veh.entry_time for veh in self.vehicles])[None, :]
         s = np.where(entered, s, np.minimum(s, -1e-9))  # not yet entered: still before the deck
-        on = entered & (s <= self.length)
+        x_all = np.where(np.array([veh.direction for veh in self.vehicles]) > 0, s, self.length - s)
+        on = entered & on_deck(x_all, self.length)
         present = np.flatnonzero(on.any(axis=0))
         direction = np.array([self.vehicles[j].direction for j in present], dtype=float)
         s, v, a = s[:, present], v[:, present], a[:, present]
@@ -171,7 +202,7 @@ class ScriptedTraffic:
     def frame(self, t: float) -> TrafficFrame:
         """The vehicles on the deck at time ``t`` (s)."""
         b = self.block(np.array([t]))
-        on = (b.x[0] >= 0) & (b.x[0] <= self.length)
+        on = on_deck(b.x[0], self.length)
         keep = np.flatnonzero(on)
         return TrafficFrame(
             ids=tuple(b.ids[j] for j in keep), x=b.x[0, keep], v=b.v[0, keep], a=b.a[0, keep], y=b.y[keep],
@@ -309,7 +340,7 @@ class FrameTraffic:
         V = v0[r_of] + acc[r_of] * tau + gap[r_of] / step
         A = acc[r_of]
         present = seen[1:][r_of]
-        on = present & (X >= -1e-9) & (X <= self.length + 1e-9)
+        on = present & on_deck(X, self.length)
         keep = np.flatnonzero(on.any(axis=0))
         ids = list(index)
         X = np.where(present, X, -1e6)[:, keep]  # absent: far before the deck

@@ -842,7 +842,8 @@ def _study_energy(run: _Run) -> list[CaseResult]:
     import scipy.sparse.linalg as spla
 
     from cosim.core.coupling import CoupledSystem
-    from cosim.core.integrator import Scheme, make_basis
+    from cosim.core.bases import make_basis
+    from cosim.core.schemes import Scheme
     from cosim.core.traffic import TrafficFrame
 
     bridge, _ = _euler_bernoulli_bridge()
@@ -893,7 +894,7 @@ def _study_energy(run: _Run) -> list[CaseResult]:
 
 
 def _study_time_step(run: _Run) -> list[CaseResult]:
-    from cosim.core.integrator import Scheme
+    from cosim.core.schemes import Scheme
     from cosim.core.simulation import Sensor, SolverSettings, simulate
     from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 

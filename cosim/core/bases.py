@@ -1,20 +1,14 @@
-"""Time-integration schemes and the two bases the coupled step runs on.
+"""The two bases the coupled step runs on (docs/theory.md §6.3).
 
-Schemes: Newmark average acceleration (``beta = 1/4, gamma = 1/2``, no
-numerical damping, second order) and HHT-alpha (``alpha`` in [-1/3, 0],
-``beta = (1 - alpha)^2 / 4``, ``gamma = 1/2 - alpha``), which damps spurious
-high modes while staying second order (Hilber, Hughes & Taylor 1977).
-
-Bases: :class:`DirectBasis` keeps every free DOF of the FE model (the
-reference); :class:`ModalBasis` keeps a truncated set of mass-normalised modes
-(fast). Both expose the same operations in their reduced coordinates, and
-both factorise the effective matrix ``A = M + (1 + alpha)(gamma dt C + beta
-dt^2 K)`` exactly once; vehicles enter the step as low-rank updates
-(:mod:`cosim.core.coupling`). ``n_factorizations`` and ``n_solves`` count the work.
+:class:`DirectBasis` keeps every free DOF of the FE model (the reference);
+:class:`ModalBasis` keeps a truncated set of mass-normalised modes (fast).
+Both factorise the effective matrix ``A = M + (1 + alpha)(gamma dt C + beta
+dt^2 K)`` exactly once (``n_factorizations`` counts the factorisations
+actually done, ``n_solves`` the solves of the compiled step); vehicles enter
+the step as low-rank updates (:mod:`cosim.core.coupling`). Each basis hands
+the compiled block loop its arrays as one :class:`cosim.core.kernels.BasisArrays`.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg
@@ -23,28 +17,13 @@ import scipy.sparse as sp
 from cosim.errors import ConfigError
 
 from .bridge import BridgeModel
+from .element import DeckRow
+from .kernels import DIRECT, MODAL, BasisArrays
+from .schemes import Scheme
 
-
-@dataclass(frozen=True)
-class Scheme:
-    """A member of the Newmark/HHT family: ``alpha`` (HHT), ``beta``, ``gamma``."""
-
-    name: str
-    alpha: float
-    beta: float
-    gamma: float
-
-    @classmethod
-    def newmark(cls) -> "Scheme":
-        """Average acceleration: unconditionally stable, no numerical damping."""
-        return cls("newmark", 0.0, 0.25, 0.5)
-
-    @classmethod
-    def hht(cls, alpha: float = -0.05) -> "Scheme":
-        """HHT-alpha with ``alpha`` in [-1/3, 0] (0 is Newmark)."""
-        if not -1.0 / 3.0 <= alpha <= 0.0:
-            raise ConfigError(f"`hht_alpha` must be in [-1/3, 0] (got {alpha})")
-        return cls("hht", alpha, (1.0 - alpha) ** 2 / 4.0, 0.5 - alpha)
+_EMPTY_1 = np.zeros(0)
+_EMPTY_2 = np.zeros((0, 0))
+_EMPTY_I = np.zeros(0, dtype=np.int64)
 
 
 class DirectBasis:
@@ -61,7 +40,7 @@ class DirectBasis:
     MAX_DIRECT_DOFS = 6000
 
     def __init__(self, bridge: BridgeModel, dt: float, scheme: Scheme) -> None:
-        self.bridge = bridge
+        self.bridge, self.dt, self.scheme = bridge, float(dt), scheme
         self.n = len(bridge.free)
         if self.n > self.MAX_DIRECT_DOFS:
             raise ConfigError(
@@ -77,20 +56,41 @@ class DirectBasis:
         c = 1.0 + scheme.alpha
         a_eff = (self.M + c * (scheme.gamma * dt * self.C + scheme.beta * dt * dt * self.K)).tocoo()
         self.bandwidth = int(np.max(np.abs(a_eff.col - a_eff.row)))
-        # Hand-off to LAPACK's banded Cholesky (pbtrf): the bridge is a beam, so its
-        # matrices are banded, and a banded factor is the cheapest exact solve.
-        self.cholesky_band = scipy.linalg.cholesky_banded(self._band(a_eff), lower=False)
+        self.n_factorizations = 0
+        self.n_solves = 0
+        self.cholesky_band = self._factorize(self._band(a_eff))
         bw = self.bandwidth
         # The same factor stored by rows (row j holds U[j, j:j+bw+1]) for the compiled solve.
         self.cholesky_rows = np.zeros((self.n, bw + 1))
         for k in range(bw + 1):
             self.cholesky_rows[: self.n - k, k] = self.cholesky_band[bw - k, k:]
-        self.n_factorizations = 1
-        self.n_solves = 0
         self.inverse = scipy.linalg.cho_solve_banded((self.cholesky_band, False), np.eye(self.n), check_finite=False)
         # Full DOF -> reduced index, -1 for restrained DOFs.
         self.reduced_map = np.full(bridge.ndof, -1, dtype=np.int64)
         self.reduced_map[bridge.free] = np.arange(self.n)
+
+    def _factorize(self, band: np.ndarray) -> np.ndarray:
+        """The banded Cholesky factor of the effective matrix: the only factorisation a run does (counted)."""
+        # Hand-off to LAPACK's banded Cholesky (pbtrf): the bridge is a beam, so its
+        # matrices are banded, and a banded factor is the cheapest exact solve.
+        self.n_factorizations += 1
+        return scipy.linalg.cholesky_banded(band, lower=False)
+
+    def kernel_arrays(self) -> BasisArrays:
+        """What the compiled block loop needs of this basis."""
+        return BasisArrays(
+            DIRECT, self.n, self.cholesky_rows, self.K.indptr, self.K.indices, self.K.data,
+            self.M.indptr, self.M.indices, self.M.data, self.ray_alpha, self.ray_beta, self.inverse,
+            self.reduced_map, _EMPTY_2, _EMPTY_1, _EMPTY_1, _EMPTY_1,
+        )
+
+    def sparse_rows(self, rows: list[DeckRow]) -> tuple[np.ndarray, np.ndarray]:
+        """Rows of element DOFs (``values[0]``) as (unknown index, value) pairs; -1 marks restrained DOFs."""
+        if not rows:
+            return np.zeros((0, 0), dtype=np.int64), np.zeros((0, 0))
+        idx = np.array([self.reduced_index(r.dofs) for r in rows], dtype=np.int64)
+        vals = np.array([r.values[0] for r in rows], dtype=float)
+        return idx, vals
 
     def _band(self, a: sp.coo_matrix) -> np.ndarray:
         """Upper band storage (LAPACK): ab[bw + i - j, j] = A[i, j] for i <= j."""
@@ -161,6 +161,7 @@ class ModalBasis:
         if not keep.any():
             raise ConfigError(f"no mode below `cutoff_hz` = {cutoff_hz} Hz (first is {modal.f_hz[0]:.3g} Hz)")
         self.modal = modal
+        self.dt, self.scheme = float(dt), scheme
         self.omega = modal.omega[keep]
         self.n = int(keep.sum())
         self.bridge = bridge
@@ -170,10 +171,29 @@ class ModalBasis:
         else:
             self.c_diag = bridge.alpha + bridge.beta * self.omega**2
         self.k_diag = self.omega**2
-        c = 1.0 + scheme.alpha
-        self.a_inv_diag = 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
-        self.n_factorizations = 1
+        self.n_factorizations = 0
         self.n_solves = 0
+        self.a_inv_diag = self._factorize(scheme, dt)
+
+    def _factorize(self, scheme: Scheme, dt: float) -> np.ndarray:
+        """The inverse of the (diagonal) effective matrix: the modal basis' one factorisation (counted)."""
+        self.n_factorizations += 1
+        c = 1.0 + scheme.alpha
+        return 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
+
+    def kernel_arrays(self) -> BasisArrays:
+        """What the compiled block loop needs of this basis."""
+        return BasisArrays(
+            MODAL, self.n, _EMPTY_2, _EMPTY_I, _EMPTY_I, _EMPTY_1, _EMPTY_I, _EMPTY_I, _EMPTY_1, 0.0, 0.0, _EMPTY_2,
+            _EMPTY_I, self.phi_full, self.c_diag, self.k_diag, self.a_inv_diag,
+        )
+
+    def sparse_rows(self, rows: list[DeckRow]) -> tuple[np.ndarray, np.ndarray]:
+        """Rows of element DOFs (``values[0]``) projected on the modes, as (mode index, value) pairs."""
+        vals = np.array([self.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows],
+                        dtype=float).reshape(len(rows), self.n)
+        idx = np.tile(np.arange(self.n, dtype=np.int64), (len(rows), 1))
+        return idx, vals
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         self.n_solves += 1

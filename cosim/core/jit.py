@@ -1,0 +1,54 @@
+"""numba for the numerical core: every compiled function of ``cosim.core`` is made with :func:`compiled`.
+
+Compiled functions are cached on disk (a ``cosim run`` would otherwise spend
+seconds compiling at every start). numba invalidates a cached function only
+when *its own* source file changes, but the block loop inlines functions of
+other core modules (the vehicle models): after editing one of those, a stale
+loop would run. So the cache of a core function is keyed on the whole
+``cosim/core`` folder (names, sizes and modification times of its files).
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any, Callable
+
+from numba import njit
+
+CORE = Path(__file__).resolve().parent
+
+
+def _core_stamp() -> tuple[tuple[str, int, int], ...]:
+    files = sorted(CORE.rglob("*.py"))
+    return tuple((str(p.relative_to(CORE)), p.stat().st_mtime_ns, p.stat().st_size) for p in files)
+
+
+def _install_core_locator() -> None:
+    """Register a numba cache locator whose source stamp covers every file of the core."""
+    try:
+        from numba.core.caching import InTreeCacheLocator, _CacheImpl
+    except ImportError:  # another numba layout: the per-file stamps still apply
+        return
+
+    class CoreTreeLocator(InTreeCacheLocator):
+        def get_source_stamp(self) -> Any:
+            return _core_stamp()
+
+        @classmethod
+        def from_function(cls, py_func: Any, py_file: str) -> Any:
+            if not os.path.abspath(py_file).startswith(str(CORE) + os.sep):
+                return None
+            return super().from_function(py_func, py_file)
+
+    locators = getattr(_CacheImpl, "_locator_classes", None)
+    if isinstance(locators, list) and not any(c.__name__ == "CoreTreeLocator" for c in locators):
+        locators.insert(0, CoreTreeLocator)
+
+
+_install_core_locator()
+
+
+def compiled(func: Callable[..., Any] | None = None, *, nogil: bool = False) -> Any:
+    """``numba.njit(cache=True)`` (``nogil`` releases the GIL: for the block loops a log thread overlaps)."""
+    decorate = njit(cache=True, nogil=nogil)
+    return decorate(func) if func is not None else decorate

@@ -1,0 +1,42 @@
+"""What every vehicle model shares: parameter checks and the layout of its compiled state.
+
+A vehicle model is a frozen dataclass (parameters in SI units, validated in
+``__post_init__``) plus two compiled functions of its module that the block
+loop calls for each of its vehicles (docs/theory.md §6.2):
+
+- ``coefficients``: from the Newmark predictors, the effective deck force
+  ``E_i = e0_i - (c0 n0 + c1 n1 + c2 n2)_i . a`` (linear in the unknown
+  bridge acceleration ``a``);
+- ``update``: once ``a`` is known, the vehicle's new accelerations and forces.
+
+Compiled state of one vehicle (a column of ``vstate``, :data:`STATE_ROWS`):
+body u, u', u''; wheel u, u', u''; suspension force; tyre force (the last two
+are the HHT ``F_n`` of the vehicle). Parameters: a column of ``params``
+(:data:`PARAM_ROWS` rows, the model's :meth:`pack` order, zeros after).
+"""
+from __future__ import annotations
+
+import math
+
+from cosim.errors import ConfigError
+
+#: Rows of a vehicle's compiled state: body u, u', u''; wheel u, u', u''; suspension force; tyre force.
+STATE_ROWS = 8
+#: Rows of a vehicle's compiled parameters (the longest ``pack()``).
+PARAM_ROWS = 6
+#: The kind ids the compiled loop dispatches on, one per model (see ``cosim.core.vehicles.MODELS``).
+MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR = 0, 1, 2
+
+
+def check_positive(owner: str, **values: float) -> None:
+    """Raise ConfigError unless every value is a finite number > 0 (``owner`` names the vehicle or model)."""
+    for name, value in values.items():
+        if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ConfigError(f"{owner}: `{name}` must be a finite number > 0 (got {value!r})")
+
+
+def check_non_negative(owner: str, **values: float) -> None:
+    """Raise ConfigError unless every value is a finite number >= 0."""
+    for name, value in values.items():
+        if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+            raise ConfigError(f"{owner}: `{name}` must be a finite number >= 0 (got {value!r})")

@@ -1,0 +1,92 @@
+"""Quarter-car with a tyre spring and damper: the wheel is its own DOF (docs/theory.md §5.3, §6.2).
+
+The tyre's stretch is ``u_w - w_deck - r``, so standard vehicle parameter
+sets (body, wheel, suspension, tyre) apply directly.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from ..jit import compiled
+from .base import TYRE_QUARTER_CAR, check_non_negative, check_positive
+
+
+@dataclass(frozen=True)
+class TyreQuarterCar:
+    """Quarter-car with a tyre spring and damper (wheel as its own DOF).
+
+    Args:
+        m_v: body mass, kg.  m_w: wheel mass, kg (> 0).
+        k_v, c_v: suspension, N/m and N s/m.
+        k_t, c_t: tyre, N/m and N s/m.
+    """
+
+    m_v: float
+    m_w: float
+    k_v: float
+    c_v: float
+    k_t: float
+    c_t: float = 0.0
+    kind: ClassVar[str] = "tyre-quarter-car"
+    KIND: ClassVar[int] = TYRE_QUARTER_CAR
+
+    def __post_init__(self) -> None:
+        check_positive("tyre quarter-car", m_v=self.m_v, m_w=self.m_w, k_v=self.k_v, k_t=self.k_t)
+        check_non_negative("tyre quarter-car", c_v=self.c_v, c_t=self.c_t)
+
+    @property
+    def total_mass(self) -> float:
+        """kg."""
+        return float(self.m_v + self.m_w)
+
+    def pack(self) -> tuple[float, ...]:
+        """Compiled parameters: m_v, m_w, k_v, c_v, k_t, c_t."""
+        return (self.m_v, self.m_w, self.k_v, self.c_v, self.k_t, self.c_t)
+
+    @classmethod
+    def golden_car(cls, m_v: float) -> "TyreQuarterCar":
+        """The IRI reference ("golden car") ratios scaled to body mass ``m_v`` (kg).
+
+        k_s/m_s = 63.3 1/s^2, c_s/m_s = 6.0 1/s, k_t/m_s = 653 1/s^2,
+        m_u/m_s = 0.15 (Sayers, Gillespie & Queiroz, World Bank TP 45, 1986).
+        """
+        return cls(m_v=m_v, m_w=0.15 * m_v, k_v=63.3 * m_v, c_v=6.0 * m_v, k_t=653.0 * m_v, c_t=0.0)
+
+
+@compiled
+def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, c0, c1, c2, aux):  # noqa: ANN001, ANN201
+    """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.7)); ``e0[i]`` holds ``-(1+alpha) m g`` on entry."""
+    m_v, m_w, k_v, c_v, k_t, c_t = p[0, i], p[1, i], p[2, i], p[3, i], p[4, i], p[5, i]
+    ub, vb, uw, vw = pred[0, i], pred[1, i], pred[2, i], pred[3, i]
+    w0, w1d, w1v = dots[0, i], dots[1, i], dots[2, i]
+    mv = k_v * b2 + c_v * g1
+    mt = k_t * b2 + c_t * g1
+    S0 = k_v * (ub - uw) + c_v * (vb - vw)
+    T0 = k_t * (uw - w0 - r) + c_t * (vw - w1v - v * w1d - v * r_x)
+    R1 = -ca * S0 + alpha * vstate[6, i]
+    R2 = ca * (S0 - T0) - alpha * (vstate[6, i] - vstate[7, i])
+    den = (m_v + ca * mv) * (m_w + ca * mv + ca * mt) - (ca * mv) ** 2
+    e0[i] += ca * (T0 + mt * ((m_v + ca * mv) * R2 + ca * mv * R1) / den)
+    kappa = ca * (1.0 - ca * mt * (m_v + ca * mv) / den)
+    c0[i] = kappa * (k_t * b2 + c_t * g1)
+    c1[i] = kappa * c_t * v * b2
+    aux[0, i], aux[1, i], aux[2, i], aux[3, i], aux[4, i], aux[5, i] = S0, T0, R1, R2, den, 0.0
+
+
+@compiled
+def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: ANN001, ANN201
+    """Body and wheel accelerations, suspension and tyre forces, and the deck force once ``a`` is known.
+
+    Returns ``(acc_body, acc_wheel, suspension, tyre, deck)``; ``deck`` excludes the weight.
+    """
+    m_v, m_w, k_v, c_v, k_t, c_t = p[0, i], p[1, i], p[2, i], p[3, i], p[4, i], p[5, i]
+    S0, T0, R1, R2, den = aux[0, i], aux[1, i], aux[2, i], aux[3, i], aux[4, i]
+    mv = k_v * b2 + c_v * g1
+    mt = k_t * b2 + c_t * g1
+    ta = (k_t * b2 + c_t * g1) * n0a + c_t * v * b2 * n1a
+    acc_w = ((m_v + ca * mv) * (R2 + ca * ta) + ca * mv * R1) / den
+    acc_b = ((m_w + ca * mv + ca * mt) * R1 + ca * mv * (R2 + ca * ta)) / den
+    susp = S0 + mv * (acc_b - acc_w)
+    tyre = T0 + mt * acc_w - ta
+    return acc_b, acc_w, susp, tyre, tyre
