@@ -10,9 +10,10 @@ left twists the deck negatively.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Sequence, Union
+from typing import Union
 
 import numpy as np
 import numpy.typing as npt
@@ -143,7 +144,7 @@ class ModalResult:
     kinds: list[str]
     dominant: list[str]
     participation: dict[str, npt.NDArray[np.float64]]
-    bridge: "BridgeModel" = field(repr=False)
+    bridge: BridgeModel = field(repr=False)
 
     @property
     def f_hz(self) -> npt.NDArray[np.float64]:
@@ -179,7 +180,7 @@ class StaticResult:
     """Static displacements ``d`` (full DOF vector, m and rad) under given loads."""
 
     d: npt.NDArray[np.float64]
-    bridge: "BridgeModel" = field(repr=False)
+    bridge: BridgeModel = field(repr=False)
 
     def deck_displacement(self, x: float, y: float) -> float:
         """Vertical displacement of deck point (x, y), m, positive up."""
@@ -360,7 +361,8 @@ class BridgeModel:
         extra = 1 if name in ("bending_moment", "psi") else 0
         n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra)[0]
         if name == "bending_moment":
-            row = -self.material.E * (self.section.I_y * n[FIELD_INDEX["theta_y"]] - self.section.I_yz * n[FIELD_INDEX["theta_z"]])
+            sec = self.section
+            row = -self.material.E * (sec.I_y * n[FIELD_INDEX["theta_y"]] - sec.I_yz * n[FIELD_INDEX["theta_z"]])
         elif name == "psi":
             row = n[FIELD_INDEX["theta_x"]]
         elif name == "w_deck":
@@ -578,7 +580,8 @@ def build_bridge(
     if isinstance(damping, ExplicitDamping):
         if damping.alpha < 0 or damping.beta < 0:
             raise ConfigError("Rayleigh `alpha` and `beta` must be >= 0")
-        return _with_damping(bridge, damping.alpha, damping.beta, f"explicit alpha={damping.alpha:g}, beta={damping.beta:g}")
+        note = f"explicit alpha={damping.alpha:g}, beta={damping.beta:g}"
+        return _with_damping(bridge, damping.alpha, damping.beta, note)
     z1, z2 = damping.ratios
     modal = bridge.modes(count=max(30, _max_mode_number(damping.modes)))
     i1, i2 = modal.index_of(damping.modes[0]), modal.index_of(damping.modes[1])

@@ -10,8 +10,9 @@ loop would run. So the cache of a core function is keyed on the whole
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from numba import njit
 

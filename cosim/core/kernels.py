@@ -310,15 +310,15 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted)
         acc_w = 0.0
         susp = 0.0
         tyre = 0.0
-        deck = -fleet.weight[i]
+        part = 0.0
+        elastic = 0.0
         if kind == QUARTER_CAR:
-            acc_b, acc_w, susp, tyre, part = quarter_car.update(i, fleet.params, vstate, aux, v, a, n0a, n1a, n2a,
-                                                                b2, g1, ca, alpha)
-            deck += part
+            acc_b, acc_w, susp, tyre, part, elastic = quarter_car.update(
+                i, fleet.params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
         elif kind == TYRE_QUARTER_CAR:
-            acc_b, acc_w, susp, tyre, part = tyre_quarter_car.update(i, fleet.params, vstate, aux, v, a, n0a, n1a,
-                                                                     n2a, b2, g1, ca, alpha)
-            deck += part
+            acc_b, acc_w, susp, tyre, part, elastic = tyre_quarter_car.update(
+                i, fleet.params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
+        deck = -fleet.weight[i] + part
         vstate[0, i] = pred[0, i] + b2 * acc_b
         vstate[1, i] = pred[1, i] + g1 * acc_b
         vstate[2, i] = acc_b
@@ -332,7 +332,9 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted)
         vstate[6, i] = susp
         vstate[7, i] = tyre
         contact[i] = -deck
-        weighted[i] = -fleet.weight[i] + susp + tyre if kind != MOVING_FORCE else -fleet.weight[i]
+        # The HHT F_{n+1}: weight and the elastic force on the deck, not the wheel's inertia
+        # (docs/theory.md §6.2): the suspension for rigid contact, the tyre for a tyre quarter-car.
+        weighted[i] = -fleet.weight[i] + elastic if kind != MOVING_FORCE else -fleet.weight[i]
 
 
 # ------------------------------------------------------------------- shared

@@ -22,12 +22,12 @@ class Scheme:
     gamma: float
 
     @classmethod
-    def newmark(cls) -> "Scheme":
+    def newmark(cls) -> Scheme:
         """Average acceleration: unconditionally stable, no numerical damping."""
         return cls("newmark", 0.0, 0.25, 0.5)
 
     @classmethod
-    def hht(cls, alpha: float = -0.05) -> "Scheme":
+    def hht(cls, alpha: float = -0.05) -> Scheme:
         """HHT-alpha with ``alpha`` in [-1/3, 0] (0 is Newmark)."""
         if not -1.0 / 3.0 <= alpha <= 0.0:
             raise ConfigError(f"`hht_alpha` must be in [-1/3, 0] (got {alpha})")

@@ -79,7 +79,7 @@ class TrafficBlock:
     y: npt.NDArray[np.float64]
 
     @classmethod
-    def from_frame(cls, frame: TrafficFrame) -> "TrafficBlock":
+    def from_frame(cls, frame: TrafficFrame) -> TrafficBlock:
         return cls(frame.ids, frame.models, frame.x[None, :], frame.v[None, :], frame.a[None, :], frame.y)
 
 

@@ -75,7 +75,9 @@ def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, 
 def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: ANN001, ANN201
     """Body and wheel accelerations, suspension force and the deck force once ``a`` is known.
 
-    Returns ``(acc_body, acc_wheel, suspension, tyre, deck)``; ``deck`` excludes the weight.
+    Returns ``(acc_body, acc_wheel, suspension, tyre, deck, elastic)``: ``deck`` is the force the wheel
+    puts on the deck (weight excluded, wheel inertia included), ``elastic`` its non-inertial part (the
+    suspension force), which HHT weights.
     """
     m_w, c_v = p[1, i], p[3, i]
     F0, h, den, m_hat = aux[0, i], aux[1, i], aux[2, i], aux[3, i]
@@ -83,4 +85,4 @@ def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: 
     acc_b = -(ca * (F0 - qa) - alpha * vstate[6, i]) / den
     susp = F0 - qa + m_hat * acc_b
     acc_w = n0a + (2.0 * v * g1 + b2 * a) * n1a + b2 * v * v * n2a + h
-    return acc_b, acc_w, susp, 0.0, susp - m_w * acc_w
+    return acc_b, acc_w, susp, 0.0, susp - m_w * acc_w, susp

@@ -45,7 +45,7 @@ class TyreQuarterCar:
         return (self.m_v, self.m_w, self.k_v, self.c_v, self.k_t, self.c_t)
 
     @classmethod
-    def golden_car(cls, m_v: float) -> "TyreQuarterCar":
+    def golden_car(cls, m_v: float) -> TyreQuarterCar:
         """The IRI reference ("golden car") ratios scaled to body mass ``m_v`` (kg).
 
         k_s/m_s = 63.3 1/s^2, c_s/m_s = 6.0 1/s, k_t/m_s = 653 1/s^2,
@@ -78,7 +78,8 @@ def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, 
 def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: ANN001, ANN201
     """Body and wheel accelerations, suspension and tyre forces, and the deck force once ``a`` is known.
 
-    Returns ``(acc_body, acc_wheel, suspension, tyre, deck)``; ``deck`` excludes the weight.
+    Returns ``(acc_body, acc_wheel, suspension, tyre, deck, elastic)``: only the tyre touches the deck, so
+    both the deck force (weight excluded) and its non-inertial part are the tyre force.
     """
     m_v, m_w, k_v, c_v, k_t, c_t = p[0, i], p[1, i], p[2, i], p[3, i], p[4, i], p[5, i]
     S0, T0, R1, R2, den = aux[0, i], aux[1, i], aux[2, i], aux[3, i], aux[4, i]
@@ -89,4 +90,4 @@ def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: 
     acc_b = ((m_w + ca * mv + ca * mt) * R1 + ca * mv * (R2 + ca * ta)) / den
     susp = S0 + mv * (acc_b - acc_w)
     tyre = T0 + mt * acc_w - ta
-    return acc_b, acc_w, susp, tyre, tyre
+    return acc_b, acc_w, susp, tyre, tyre, tyre

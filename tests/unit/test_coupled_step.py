@@ -1,0 +1,213 @@
+"""The compiled coupled step against an independent monolithic solution, the vehicle registry, and the
+Python API's input checks.
+
+Reference for the step: a vehicle standing still on the deck makes a linear
+system with constant matrices (the bridge's modes plus the vehicle's own
+DOFs), which any Newmark/HHT implementation integrates directly. The one
+below assembles it whole and solves it monolithically, step by step, with
+numpy: nothing of cosim's condensation or Woodbury update is shared.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cosim.core.bases import make_basis
+from cosim.core.bridge import ExplicitDamping, build_bridge
+from cosim.core.coupling import CoupledSystem
+from cosim.core.roughness import RoadProfile
+from cosim.core.schemes import Scheme
+from cosim.core.section import Material, SectionProperties
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
+from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle, TrafficBlock
+from cosim.core.vehicles import MODELS, MovingForce, QuarterCar, TyreQuarterCar
+from cosim.errors import ConfigError
+
+MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
+SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_s=0.0, z_s=-0.4,
+                        J=0.15, I_w=19.0, A_sy=2.5, A_sz=0.9, deck_y=(-6.6, 6.6))
+GRAVITY = 9.81
+TOL_MONOLITHIC = 1e-9  # of the peak: the same linear system solved two ways, round-off only
+
+
+def _bridge():
+    return build_bridge(spans=[30.0], elements_per_span=12, material=MAT, section=SEC,
+                        supports=["pinned", "fork"], damping=ExplicitDamping(alpha=0.3, beta=1e-3))
+
+
+def _monolithic(bridge, basis, model: TyreQuarterCar, x: float, y: float, scheme: Scheme, dt: float, steps: int):
+    """Deck deflection under the wheel and tyre force of a tyre quarter-car parked at (x, y), by a monolithic
+    HHT/Newmark integration of [modal coordinates, body, wheel] (Hilber, Hughes & Taylor 1977)."""
+    m = basis.n
+    row = bridge.deck_point_row(x, y)
+    n0 = basis.reduce_rows(row.dofs[None, :], row.values[:1])[0]  # deck w at the wheel, per mode
+    size = m + 2
+    M = np.zeros((size, size))
+    C = np.zeros((size, size))
+    K = np.zeros((size, size))
+    M[:m, :m] = np.eye(m)
+    C[:m, :m] = np.diag(basis.c_diag)
+    K[:m, :m] = np.diag(basis.k_diag)
+    b, w = m, m + 1
+    M[b, b], M[w, w] = model.m_v, model.m_w
+    for mat, k_v, k_t in ((K, model.k_v, model.k_t), (C, model.c_v, model.c_t)):
+        # Suspension between body and wheel; tyre between wheel and deck point (stretch u_w - n0 q).
+        mat[b, b] += k_v
+        mat[b, w] -= k_v
+        mat[w, b] -= k_v
+        mat[w, w] += k_v + k_t
+        mat[w, :m] -= k_t * n0
+        mat[:m, w] -= k_t * n0
+        mat[:m, :m] += k_t * np.outer(n0, n0)
+    f = np.zeros(size)
+    f[:m] = -model.total_mass * GRAVITY * n0  # displacements from the vehicle's equilibrium on a rigid road
+    al, be, ga = scheme.alpha, scheme.beta, scheme.gamma
+    # The vehicle arrives at t = 0+: at rest, no load before (f_0 = 0), no acceleration yet.
+    d, v, a, f_prev = np.zeros(size), np.zeros(size), np.zeros(size), np.zeros(size)
+    A = M + (1 + al) * (ga * dt * C + be * dt * dt * K)
+    deflection, tyre = [], []
+    for _ in range(steps):
+        d_star = d + dt * v + (0.5 - be) * dt * dt * a
+        v_star = v + (1 - ga) * dt * a
+        rhs = (1 + al) * f - al * f_prev - (1 + al) * (C @ v_star + K @ d_star) + al * (C @ v + K @ d)
+        f_prev = f
+        a = np.linalg.solve(A, rhs)
+        d, v = d_star + be * dt * dt * a, v_star + ga * dt * a
+        deflection.append(n0 @ d[:m])
+        tyre.append(model.total_mass * GRAVITY - (model.k_t * (d[w] - n0 @ d[:m]) + model.c_t * (v[w] - n0 @ v[:m])))
+    return np.array(deflection), np.array(tyre)
+
+
+@pytest.mark.parametrize("scheme", [Scheme.newmark(), Scheme.hht(-0.3)], ids=["newmark", "hht-0.3"])
+def test_a_parked_tyre_quarter_car_matches_a_monolithic_integration(scheme):
+    bridge = _bridge()
+    dt, steps = 2e-3, 600
+    basis = make_basis(bridge, dt, scheme, "modal", n_modes=12)
+    car = TyreQuarterCar(m_v=8000.0, m_w=800.0, k_v=4e5, c_v=2e4, k_t=3e6, c_t=3e3)
+    x, y = 11.0, 2.5  # eccentric: bending and twist
+    sensor = Sensor("wheel", x, y)
+    system = CoupledSystem(bridge, basis, scheme, dt, gravity=GRAVITY, sensors=(sensor,))
+    block = TrafficBlock(("car",), (car,), np.full((steps, 1), x), np.zeros((steps, 1)), np.zeros((steps, 1)),
+                         np.array([y]))
+    report = system.advance(block)
+    ref_w, ref_tyre = _monolithic(bridge, basis, car, x, y, scheme, dt, steps)
+    assert np.max(np.abs(report.sensors[:, 0] - ref_w)) <= TOL_MONOLITHIC * np.max(np.abs(ref_w))
+    assert np.max(np.abs(report.contact_force[:, 0] - ref_tyre)) <= TOL_MONOLITHIC * np.max(np.abs(ref_tyre))
+
+
+# ------------------------------------------------------------------ registry
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_every_registered_model_runs_through_the_compiled_step(name):
+    """A vehicle parked on the deck settles to its weight as contact force (statics), whatever its model."""
+    examples = {"moving-force": MovingForce(9000.0),
+                "quarter-car": QuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4),
+                "tyre-quarter-car": TyreQuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4, k_t=3e6, c_t=1e4)}
+    assert set(examples) == set(MODELS), "add an example of the new model here"
+    model = examples[name]
+    bridge = _bridge()
+    dt, steps = 5e-3, 4000
+    scheme = Scheme.newmark()
+    system = CoupledSystem(bridge, make_basis(bridge, dt, scheme), scheme, dt, gravity=GRAVITY)
+    block = TrafficBlock(("v",), (model,), np.full((steps, 1), 15.0), np.zeros((steps, 1)), np.zeros((steps, 1)),
+                         np.zeros(1))
+    report = system.advance(block)
+    weight = model.total_mass * GRAVITY
+    # Statics: the settled contact force is the weight (damped transients decay well within 20 s).
+    assert report.contact_force[-1, 0] == pytest.approx(weight, rel=1e-6)
+    assert report.on_deck.all() and not report.lifted.any()
+
+
+def test_a_vehicle_off_the_deck_loads_nothing():
+    bridge = _bridge()
+    dt = 5e-3
+    scheme = Scheme.newmark()
+    system = CoupledSystem(bridge, make_basis(bridge, dt, scheme), scheme, dt, sensors=(Sensor("mid", 15.0),))
+    x = np.array([[-0.5], [bridge.length + 0.5]])  # before and after the deck
+    block = TrafficBlock(("v",), (MovingForce(9000.0),), x, np.full((2, 1), 10.0), np.zeros((2, 1)), np.zeros(1))
+    report = system.advance(block)
+    assert not report.on_deck.any()
+    assert np.all(report.contact_force == 0.0) and np.all(report.sensors == 0.0)
+
+
+def test_the_basis_counts_its_factorisations_and_the_loop_its_solves():
+    bridge = _bridge()
+    dt, scheme = 5e-3, Scheme.newmark()
+    basis = make_basis(bridge, dt, scheme)
+    system = CoupledSystem(bridge, basis, scheme, dt)
+    car = QuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4)
+    for k in range(5):  # five blocks, vehicles on the deck in the last three
+        q = 1 if k >= 2 else 0
+        x = np.full((100, q), 10.0)
+        system.advance(TrafficBlock(("c",) * q, (car,) * q, x, 0 * x, 0 * x, np.zeros(q)))
+    assert basis.n_factorizations == 1
+    # Direct basis: one banded solve per step, a second for the Woodbury correction with vehicles on the deck.
+    assert basis.n_solves == 200 * 1 + 300 * 2
+    assert make_basis(bridge, dt, scheme, "modal", n_modes=5).n_factorizations == 1
+
+
+# ------------------------------------------------------- the API's checks
+
+
+def _traffic(length: float, y: float = 0.0) -> ScriptedTraffic:
+    return ScriptedTraffic((ScriptedVehicle("truck", MovingForce(3e4), y, 20.0),), length)
+
+
+def test_simulate_rejects_traffic_made_for_another_bridge():
+    with pytest.raises(ConfigError, match=r"traffic was made for a bridge 40 m long, this one is 30 m"):
+        simulate(_bridge(), _traffic(40.0), 1.0)
+
+
+def test_simulate_rejects_a_wheel_path_off_the_deck_naming_the_vehicle():
+    with pytest.raises(ConfigError, match=r"vehicle truck: its wheel path y = 9 m lies off the deck"):
+        simulate(_bridge(), _traffic(30.0, y=9.0), 1.0)
+
+
+def test_simulate_rejects_sensors_off_the_deck_and_duplicate_names():
+    with pytest.raises(ConfigError, match=r"sensor far: `x` must lie on the bridge"):
+        simulate(_bridge(), _traffic(30.0), 1.0, sensors=[Sensor("far", 31.0)])
+    with pytest.raises(ConfigError, match=r"sensor edge: `y` must lie on the deck"):
+        simulate(_bridge(), _traffic(30.0), 1.0, sensors=[Sensor("edge", 10.0, 7.0)])
+    with pytest.raises(ConfigError, match="sensor names must be unique"):
+        simulate(_bridge(), _traffic(30.0), 1.0, sensors=[Sensor("a", 10.0), Sensor("a", 12.0)])
+
+
+def test_simulate_rejects_a_road_that_does_not_cover_the_deck():
+    flat = np.zeros((1, 41))
+    road = RoadProfile(path_y=(0.0,), x0=0.0, dx=0.5, r=flat, r_x=flat, description="a 20 m survey")
+    with pytest.raises(ConfigError, match=r"must cover the deck, 0 <= x <= 30 m"):
+        simulate(_bridge(), _traffic(30.0), 1.0, road=road)
+
+
+@pytest.mark.parametrize("kwargs, key", [
+    ({"dt": float("nan")}, "dt"), ({"dt": -1.0}, "dt"), ({"gravity": float("inf")}, "gravity"),
+    ({"scheme": "euler"}, "scheme"), ({"basis": "fourier"}, "basis"), ({"modes": 0}, "modes"),
+])
+def test_solver_settings_reject_non_physical_values_naming_the_key(kwargs, key):
+    with pytest.raises(ConfigError, match=f"`{key}`"):
+        SolverSettings(**kwargs)
+
+
+@pytest.mark.parametrize("field, value", [("y", float("nan")), ("speed", float("inf")), ("entry_time", "0")])
+def test_scripted_vehicles_reject_non_finite_values_naming_the_key(field, value):
+    args = {"id": "car", "model": MovingForce(1e3), "y": 0.0, "speed": 10.0, field: value}
+    with pytest.raises(ConfigError, match=f"vehicle car: `{field}`"):
+        ScriptedVehicle(**args)
+
+
+def test_scripted_traffic_rejects_a_bad_length_and_a_non_model():
+    with pytest.raises(ConfigError, match="`length` must be the bridge's length"):
+        ScriptedTraffic((), float("nan"))
+    with pytest.raises(ConfigError, match="vehicle car: `model` must be one of the vehicle models"):
+        ScriptedVehicle("car", "quarter-car", 0.0, 10.0)
+
+
+def test_a_basis_built_for_another_bridge_or_step_is_refused():
+    bridge, other = _bridge(), _bridge()
+    scheme = Scheme.newmark()
+    with pytest.raises(ConfigError, match="another bridge model"):
+        CoupledSystem(bridge, make_basis(other, 5e-3, scheme), scheme, 5e-3)
+    with pytest.raises(ConfigError, match="built for dt = 0.005 s"):
+        CoupledSystem(bridge, make_basis(bridge, 5e-3, scheme), scheme, 1e-3)
