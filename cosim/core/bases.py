@@ -1,4 +1,4 @@
-"""The two bases the coupled step runs on (docs/theory.md §6.3).
+"""The two bases the coupled step runs on (docs/theory.md §6.6-6.8).
 
 :class:`DirectBasis` keeps every free DOF of the FE model (the reference);
 :class:`ModalBasis` keeps a truncated set of mass-normalised modes (fast).

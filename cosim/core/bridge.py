@@ -1,4 +1,4 @@
-"""The bridge: a continuous beam of 7-DOF elements with supports, damping, modes and statics.
+"""The bridge: a continuous beam of 7-DOF elements with supports, damping, modes and statics (docs/theory.md §4).
 
 Global DOF ``7 * node + k`` with ``k`` in :data:`cosim.core.element.DOF_NAMES` order;
 nodes are numbered from the first abutment (x = 0) along +x.

@@ -31,7 +31,7 @@ Kinetic energy per unit length (the S-C offset couples translations and twist)::
 
 with ``e_y = y_s - y_c``, ``e_z = z_s - z_c``. These are derived from the
 displacement field above, not transcribed from the paper (whose eqs. 7-10 have
-typos, see DESIGN.md section 9).
+typos, see docs/theory.md §3.7).
 
 Interpolation: linear ``u``; bending in each plane with the interdependent
 (Friedman-Kosmatka) Timoshenko shape functions, which are free of shear locking

@@ -102,7 +102,7 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 # ------------------------------------------------------------- contact rows
 @compiled
 def contact_rows(x, y, deck):  # noqa: ANN001, ANN201
-    """Element index and (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck."""
+    """Element index and (3, 14) values of w, w_x, w_xx at each contact point (docs/theory.md §5.1); e = -1 off the deck."""
     q = x.shape[0]
     nodes_x, cw, ct = deck.nodes_x, deck.cw, deck.ct
     n_el = nodes_x.shape[0] - 1
@@ -137,7 +137,7 @@ def contact_rows(x, y, deck):  # noqa: ANN001, ANN201
 # ----------------------------------------------- basis-specific operations
 @compiled
 def internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha):  # noqa: ANN001, ANN201
-    """rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n  (docs/theory.md (6.4))."""
+    """rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n  (docs/theory.md (6.2)-(6.4))."""
     n = basis.n
     if basis.kind == DIRECT:  # C = ray_a M + ray_b K: two CSR products instead of three
         for j in range(n):
@@ -205,7 +205,7 @@ def solve(basis, b, counters):  # noqa: ANN001, ANN201
 
 @compiled
 def woodbury(basis, idx, rv, p, z_b, S, pz, us, counters):  # noqa: ANN001, ANN201
-    """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md (6.9)).
+    """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
 
     Capacitance matrix ``S = I + P A^-1 U^T``: on the direct basis from the
     dense inverse's entries at the rows' few unknowns (no solve per vehicle);
@@ -333,7 +333,7 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted)
         vstate[7, i] = tyre
         contact[i] = -deck
         # The HHT F_{n+1}: weight and the elastic force on the deck, not the wheel's inertia
-        # (docs/theory.md §6.2): the suspension for rigid contact, the tyre for a tyre quarter-car.
+        # (docs/theory.md (6.5)): the suspension for rigid contact, the tyre for a tyre quarter-car.
         weighted[i] = -fleet.weight[i] + elastic if kind != MOVING_FORCE else -fleet.weight[i]
 
 
@@ -353,7 +353,7 @@ def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN2
 
 @compiled
 def _record(step, elems, contact, fleet, out):  # noqa: ANN001, ANN201
-    """The step's vehicle outputs, and lift-off: the one place where it is detected and counted."""
+    """The step's vehicle outputs, and lift-off (docs/theory.md §5.7): the one place where it is detected and counted."""
     counters = out.counters
     for i in range(elems.shape[0]):
         on = elems[i] >= 0

@@ -1,4 +1,4 @@
-"""Quasi-static response of the bridge to moving traffic: the same loads, no inertia.
+"""Quasi-static response of the bridge to moving traffic: the same loads, no inertia (docs/theory.md §7.4).
 
 The dynamic amplification factor (DAF) of a sensor is its dynamic peak over
 the peak of a quasi-static run of the same traffic: every vehicle on the deck

@@ -1,4 +1,4 @@
-"""Road roughness: ISO 8608 random profiles and user profiles, one per wheel path.
+"""Road roughness: ISO 8608 random profiles and user profiles, one per wheel path (docs/theory.md §7.1-7.3).
 
 ISO 8608 gives the displacement PSD ``G_d(n) = G_d(n0) (n / n0)^-w`` with
 ``n0 = 0.1 cycle/m`` and waviness ``w = 2``. The class value is the geometric

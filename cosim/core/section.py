@@ -1,4 +1,4 @@
-"""Materials and cross-section constants.
+"""Materials and cross-section constants (docs/theory.md §2).
 
 Section coordinates are the bridge's lateral ``y`` (positive to the left looking
 along +x) and vertical ``z`` (up), in metres, relative to any origin; ``y = 0``

@@ -2,7 +2,7 @@
 
 A sensor reads ``s = r . d`` (or ``r . d'``, ``r . d''``) with ``r`` its row:
 the vertical displacement of the deck point ``(x, y)`` (bending and twist,
-``w = w_S + (y - y_S) theta_x``, docs/theory.md §1), or the vertical bending
+``w = w_S + (y - y_S) theta_x``, docs/theory.md §1.4), or the vertical bending
 moment of the section at ``x``. The time integration, the quasi-static
 response and the static load cases all use :func:`sensor_row`.
 """

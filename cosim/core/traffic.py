@@ -1,4 +1,4 @@
-"""Traffic seen by the bridge: which vehicles are where, how fast, at a given time.
+"""Traffic seen by the bridge: which vehicles are where, how fast, at a given time (docs/theory.md §6.10).
 
 A traffic source answers :meth:`TrafficSource.frame` for the time of every
 beam step: the vehicles in the simulation with their contact point ``x``

@@ -2,7 +2,7 @@
 
 A vehicle model is a frozen dataclass (parameters in SI units, validated in
 ``__post_init__``) plus two compiled functions of its module that the block
-loop calls for each of its vehicles (docs/theory.md §6.2):
+loop calls for each of its vehicles (docs/theory.md §6.2-6.5, (6.6)):
 
 - ``coefficients``: from the Newmark predictors, the effective deck force
   ``E_i = e0_i - (c0 n0 + c1 n1 + c2 n2)_i . a`` (linear in the unknown
