@@ -102,7 +102,10 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 # ------------------------------------------------------------- contact rows
 @compiled
 def contact_rows(x, y, deck):  # noqa: ANN001, ANN201
-    """Element index and (3, 14) values of w, w_x, w_xx at each contact point (docs/theory.md §5.1); e = -1 off the deck."""
+    """Element index and (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
+
+    docs/theory.md §5.1.
+    """
     q = x.shape[0]
     nodes_x, cw, ct = deck.nodes_x, deck.cw, deck.ct
     n_el = nodes_x.shape[0] - 1
@@ -353,7 +356,7 @@ def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN2
 
 @compiled
 def _record(step, elems, contact, fleet, out):  # noqa: ANN001, ANN201
-    """The step's vehicle outputs, and lift-off (docs/theory.md §5.7): the one place where it is detected and counted."""
+    """The step's vehicle outputs, and lift-off: the one place where it is detected and counted (theory §5.7)."""
     counters = out.counters
     for i in range(elems.shape[0]):
         on = elems[i] >= 0

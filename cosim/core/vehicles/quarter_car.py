@@ -56,7 +56,10 @@ class QuarterCar:
 
 @compiled
 def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, c0, c1, c2, aux):  # noqa: ANN001, ANN201
-    """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.6)-(6.10)); ``e0[i]`` holds ``-(1+alpha) m g`` on entry."""
+    """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.6)-(6.10)).
+
+    ``e0[i]`` holds ``-(1+alpha) m g`` on entry.
+    """
     m_v, m_w, k_v, c_v = p[0, i], p[1, i], p[2, i], p[3, i]
     ub, vb = pred[0, i], pred[1, i]
     w0, w1d, w1v, w2d, w1v1 = dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i]

@@ -56,7 +56,10 @@ class TyreQuarterCar:
 
 @compiled
 def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, c0, c1, c2, aux):  # noqa: ANN001, ANN201
-    """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.11)-(6.13)); ``e0[i]`` holds ``-(1+alpha) m g`` on entry."""
+    """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.11)-(6.13)).
+
+    ``e0[i]`` holds ``-(1+alpha) m g`` on entry.
+    """
     m_v, m_w, k_v, c_v, k_t, c_t = p[0, i], p[1, i], p[2, i], p[3, i], p[4, i], p[5, i]
     ub, vb, uw, vw = pred[0, i], pred[1, i], pred[2, i], pred[3, i]
     w0, w1d, w1v = dots[0, i], dots[1, i], dots[2, i]
