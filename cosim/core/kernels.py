@@ -67,15 +67,17 @@ _on_deck = compiled(on_deck)
 
 # ----------------------------------------------------------------- banded LA
 @compiled
-def band_solve(ur, b):  # noqa: ANN001, ANN201
-    """Solve (U^T U) x = b with U the upper banded Cholesky factor stored by rows: ur[j, k] = U[j, j + k].
+def band_solve_into(ur, b, x):  # noqa: ANN001, ANN201
+    """x = (U^T U)^{-1} b with U the upper banded Cholesky factor stored by rows: ur[j, k] = U[j, j + k].
 
     Row storage makes both substitutions run over contiguous memory (an axpy
     forward, a dot product backward), about twice as fast as LAPACK's column
     storage for these narrow bands, and callable without leaving compiled code.
+    ``x`` may be ``b`` itself.
     """
     n, w = ur.shape
-    x = b.copy()
+    for j in range(n):
+        x[j] = b[j]
     for j in range(n):
         xj = x[j] / ur[j, 0]
         x[j] = xj
@@ -86,6 +88,13 @@ def band_solve(ur, b):  # noqa: ANN001, ANN201
         for k in range(1, min(w, n - i)):
             s -= ur[i, k] * x[i + k]
         x[i] = s / ur[i, 0]
+
+
+@compiled
+def band_solve(ur, b):  # noqa: ANN001, ANN201
+    """(U^T U)^{-1} b as a new array (see :func:`band_solve_into`)."""
+    x = np.empty_like(b)
+    band_solve_into(ur, b, x)
     return x
 
 
@@ -101,19 +110,22 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 
 # ------------------------------------------------------------- contact rows
 @compiled
-def contact_rows(x, y, deck):  # noqa: ANN001, ANN201
-    """Element index and (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
+def contact_rows(x, y, deck, elems, vals):  # noqa: ANN001, ANN201
+    """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
 
     docs/theory.md §5.1.
     """
     q = x.shape[0]
     nodes_x, cw, ct = deck.nodes_x, deck.cw, deck.ct
     n_el = nodes_x.shape[0] - 1
-    elems = np.full(q, -1, dtype=np.int64)
-    vals = np.zeros((q, 3, cw.shape[1]))
     for i in range(q):
+        elems[i] = -1
         xi_abs = x[i]
         if not _on_deck(xi_abs, deck.length):
+            for k in range(cw.shape[1]):
+                vals[i, 0, k] = 0.0
+                vals[i, 1, k] = 0.0
+                vals[i, 2, k] = 0.0
             continue
         e = np.searchsorted(nodes_x, xi_abs, side="right") - 1
         e = min(max(e, 0), n_el - 1)
@@ -134,7 +146,6 @@ def contact_rows(x, y, deck):  # noqa: ANN001, ANN201
             vals[i, 1, k] = s1
             vals[i, 2, k] = s2
         elems[i] = e
-    return elems, vals
 
 
 # ----------------------------------------------- basis-specific operations
@@ -198,16 +209,18 @@ def project_contacts(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
 
 
 @compiled
-def solve(basis, b, counters):  # noqa: ANN001, ANN201
-    """A^{-1} b with the once-factorised effective matrix (banded Cholesky, or the diagonal of a modal basis)."""
+def solve(basis, b, x, counters):  # noqa: ANN001, ANN201
+    """x = A^{-1} b with the once-factorised effective matrix (banded Cholesky, or a modal basis' diagonal)."""
     if basis.kind == DIRECT:
         counters[2] += 1
-        return band_solve(basis.factor, b)
-    return b * basis.a_inv
+        band_solve_into(basis.factor, b, x)
+    else:
+        for j in range(b.shape[0]):
+            x[j] = b[j] * basis.a_inv[j]
 
 
 @compiled
-def woodbury(basis, idx, rv, p, z_b, S, pz, us, counters):  # noqa: ANN001, ANN201
+def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001, ANN201
     """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
 
     Capacitance matrix ``S = I + P A^-1 U^T``: on the direct basis from the
@@ -245,7 +258,7 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, counters):  # noqa: ANN001, ANN2
                 j = idx[i, kk]
                 if j >= 0:
                     us[j] += rv[i, 0, kk] * sol[i]
-        corr = band_solve(basis.factor, us)
+        band_solve_into(basis.factor, us, corr)
         counters[2] += 1
         for j in range(z_b.shape[0]):
             z_b[j] -= corr[j]
@@ -264,10 +277,10 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, counters):  # noqa: ANN001, ANN2
                 S[i, k] = s
         sol = np.linalg.solve(S, pz)
         for j in range(m):
-            corr = 0.0
+            c = 0.0
             for k in range(q):
-                corr += rv[k, 0, j] * sol[k]
-            z_b[j] -= a_inv[j] * corr
+                c += rv[k, 0, j] * sol[k]
+            z_b[j] -= a_inv[j] * c
 
 
 # --------------------------------------------------------- vehicle physics
@@ -406,12 +419,16 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
     tmp = np.empty(n)
     rhs = np.empty(n)
     us = np.empty(n)
+    corr = np.empty(n)
+    z_b = np.empty(n)
+    elems = np.empty(q, dtype=np.int64)
+    vals = np.empty((q, 3, deck.cw.shape[1]))
     for step in range(kin.x.shape[0]):
         for j in range(n):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
         internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
-        elems, vals = contact_rows(kin.x[step], kin.y, deck)
+        contact_rows(kin.x[step], kin.y, deck, elems, vals)
         project_contacts(basis, deck, elems, vals, idx, rv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
@@ -432,9 +449,9 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
                 p[i, kk] = c0[i] * rv[i, 0, kk] + c1[i] * rv[i, 1, kk] + c2[i] * rv[i, 2, kk]
                 if j >= 0:
                     rhs[j] += rv[i, 0, kk] * e0[i]
-        z_b = solve(basis, rhs, out.counters)
+        solve(basis, rhs, z_b, out.counters)
         if q > 0:
-            woodbury(basis, idx, rv, p, z_b, S, pz, us, out.counters)
+            woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters)
         if basis.kind == MODAL:
             out.counters[2] += 1  # one (diagonal) solve per step, with or without vehicles
         if not _newmark_update(d, v, a, d_star, v_star, z_b, b2, g1):
