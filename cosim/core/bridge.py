@@ -531,7 +531,10 @@ def build_bridge(
     spans = tuple(float(s) for s in spans)
     if not spans or any(not s > 0 for s in spans):
         raise ConfigError(f"`spans` must be one or more positive lengths (got {list(spans)})")
-    n_per = [int(elements_per_span)] * len(spans) if np.isscalar(elements_per_span) else list(elements_per_span)
+    if isinstance(elements_per_span, (int, np.integer)):
+        n_per = [int(elements_per_span)] * len(spans)
+    else:
+        n_per = [int(n) for n in elements_per_span]
     if len(n_per) != len(spans) or any(n < 1 for n in n_per):
         raise ConfigError("`elements_per_span` must be >= 1, one number or one per span")
     if len(supports) != len(spans) + 1:

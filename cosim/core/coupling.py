@@ -197,7 +197,7 @@ class CoupledSystem:
         for name, value in zip(("d", "v", "a"), values):
             if value.shape != (n,) or not np.all(np.isfinite(value)):
                 raise ConfigError(f"`{name}` must be {n} finite numbers (the basis' unknowns)")
-        self._state = kernels.BridgeState(*values, self._state.force)
+        self._state = kernels.BridgeState(values[0], values[1], values[2], self._state.force)
 
     def _deck_w(self, x: float, y: float) -> float:
         if not kernels.on_deck(x, self.bridge.length):

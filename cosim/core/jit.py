@@ -27,7 +27,7 @@ def _core_stamp() -> tuple[tuple[str, int, int], ...]:
 def _install_core_locator() -> None:
     """Register a numba cache locator whose source stamp covers every file of the core."""
     try:
-        from numba.core.caching import InTreeCacheLocator, _CacheImpl
+        from numba.core.caching import InTreeCacheLocator, _CacheImpl  # type: ignore[attr-defined]
     except ImportError:  # another numba layout: the per-file stamps still apply
         return
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import Any
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -127,6 +128,8 @@ def _finite(value: object, name: str, where: str = "") -> float:
 
 
 def _point(value: object, name: str, where: str) -> tuple[float, float]:
+    y: object
+    z: object
     try:
         y, z = value  # type: ignore[misc]
     except (TypeError, ValueError):
@@ -261,7 +264,7 @@ def section_from_plates(
     return _solve_fe(_cache_key(rows), nu, mesh_size)
 
 
-def _rectangles_and_union(rows: list[tuple[float, float, float, float, float]]) -> tuple[list, object]:
+def _rectangles_and_union(rows: list[tuple[float, float, float, float, float]]) -> tuple[list, Any]:
     """The plates' shapely rectangles and their union (a Polygon when connected)."""
     from shapely.geometry import Polygon
     from shapely.ops import unary_union
@@ -424,13 +427,14 @@ def section_from_constants(
             f"`I_yz` = {I_yz!r} m^4 is too large: I_y * I_z must exceed I_yz^2 "
             f"(I_y = {I_y!r}, I_z = {I_z!r}), or a principal second moment is <= 0"
         )
-    y_s = y_c if y_s is None else _finite(y_s, "y_s")
-    z_s = z_c if z_s is None else _finite(z_s, "z_s")
+    y_sc: float = y_c if y_s is None else _finite(y_s, "y_s")
+    z_sc: float = z_c if z_s is None else _finite(z_s, "z_s")
     I_w = _finite(I_w, "I_w")
     if not I_w >= 0:
         raise ConfigError(f"`I_w` must be >= 0 (got {I_w!r})")
-    shear = {}
-    for name, value in (("A_sy", A_sy), ("A_sz", A_sz)):
+    shear: dict[str, float] = {}
+    given: tuple[tuple[str, float | None], ...] = (("A_sy", A_sy), ("A_sz", A_sz))
+    for name, value in given:
         shear[name] = 5.0 / 6.0 * A if value is None else _finite(value, name)
         if not shear[name] > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {value!r})")
@@ -440,7 +444,7 @@ def section_from_constants(
     if not y_min < y_max:
         raise ConfigError(f"`deck_y` must be ordered [y_min, y_max] with y_min < y_max (got {deck_y!r})")
     return SectionProperties(
-        A=A, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_s, z_s=z_s, J=J, I_w=I_w,
+        A=A, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_sc, z_s=z_sc, J=J, I_w=I_w,
         A_sy=shear["A_sy"], A_sz=shear["A_sz"], deck_y=(y_min, y_max), source=str(source),
     )
 

@@ -86,7 +86,7 @@ class TrafficBlock:
 class TrafficSource(Protocol):
     """Anything that can say where the vehicles are at the times of a block of steps (s)."""
 
-    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock: ...
+    def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock: ...
 
 
 @dataclass(frozen=True)
@@ -175,7 +175,7 @@ class ScriptedTraffic:
             raise ConfigError(f"vehicle ids must be unique (got {', '.join(repeated)} more than once)")
         object.__setattr__(self, "_ids", frozenset(ids))
 
-    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock:
+    def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         """The vehicles on the deck at any of ``times`` (s), with their kinematics at each."""
         times = np.asarray(times, dtype=float)
         n = len(self.vehicles)
@@ -295,7 +295,7 @@ class FrameTraffic:
             del self.frames[:drop]
             self._first += drop
 
-    def block(self, times: npt.NDArray[np.float64]) -> TrafficBlock:
+    def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         times = np.asarray(times, dtype=float)
         if times[-1] > self.last_time + 1e-9:
             raise ConfigError(f"no traffic frames after t = {self.last_time} s (asked for {times[-1]} s)")
@@ -351,6 +351,6 @@ class FrameTraffic:
         last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
         Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
         return TrafficBlock(
-            tuple(ids[c] for c in keep), tuple(self.models[type_of[c]] for c in keep),
+            tuple(ids[c] for c in keep.tolist()), tuple(self.models[type_of[c]] for c in keep.tolist()),
             np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y,
         )
