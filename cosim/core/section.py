@@ -434,10 +434,10 @@ def section_from_constants(
         raise ConfigError(f"`I_w` must be >= 0 (got {I_w!r})")
     shear: dict[str, float] = {}
     given: tuple[tuple[str, float | None], ...] = (("A_sy", A_sy), ("A_sz", A_sz))
-    for name, value in given:
-        shear[name] = 5.0 / 6.0 * A if value is None else _finite(value, name)
+    for name, area in given:
+        shear[name] = 5.0 / 6.0 * A if area is None else _finite(area, name)
         if not shear[name] > 0:
-            raise ConfigError(f"`{name}` must be > 0 (got {value!r})")
+            raise ConfigError(f"`{name}` must be > 0 (got {area!r})")
     if deck_y is None:
         raise ConfigError("`deck_y` is required: the lateral extent [y_min, y_max] of the deck in m")
     y_min, y_max = _point(deck_y, "deck_y", "")
