@@ -16,6 +16,7 @@ import scipy.sparse as sp
 
 from cosim.errors import ConfigError
 
+from .banded import upper_band
 from .bridge import BridgeModel
 from .element import DeckRow
 from .kernels import DIRECT, MODAL, BasisArrays
@@ -58,7 +59,7 @@ class DirectBasis:
         self.bandwidth = int(np.max(np.abs(a_eff.col - a_eff.row)))
         self.n_factorizations = 0
         self.n_solves = 0
-        self.cholesky_band = self._factorize(self._band(a_eff))
+        self.cholesky_band = self._factorize(upper_band(a_eff))
         bw = self.bandwidth
         # The same factor stored by rows (row j holds U[j, j:j+bw+1]) for the compiled solve.
         self.cholesky_rows = np.zeros((self.n, bw + 1))
@@ -91,14 +92,6 @@ class DirectBasis:
         idx = np.array([self.reduced_index(r.dofs) for r in rows], dtype=np.int64)
         vals = np.array([r.values[0] for r in rows], dtype=float)
         return idx, vals
-
-    def _band(self, a: sp.coo_matrix) -> np.ndarray:
-        """Upper band storage (LAPACK): ab[bw + i - j, j] = A[i, j] for i <= j."""
-        upper = a.row <= a.col
-        rows, cols, vals = a.row[upper], a.col[upper], a.data[upper]
-        ab = np.zeros((self.bandwidth + 1, self.n))
-        np.add.at(ab, (self.bandwidth + rows - cols, cols), vals)
-        return ab
 
     def reduced_index(self, dofs: np.ndarray) -> np.ndarray:
         """Reduced indices of full DOFs (-1 where restrained)."""

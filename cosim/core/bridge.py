@@ -23,6 +23,7 @@ import scipy.sparse.linalg as spla
 
 from cosim.errors import ConfigError, ModelError
 
+from .banded import upper_band
 from .element import (
     DOF_INDEX,
     DOF_NAMES,
@@ -72,6 +73,8 @@ MODE_KINDS: dict[str, tuple[str, ...]] = {
     "torsion": ("theta_x", "psi"),
 }
 _PURE_KIND_SHARE = 0.75
+#: A Cholesky pivot of K below this share of its diagonal entry is a mechanism (round-off is ~1e-16).
+MECHANISM_PIVOT = 1e-11
 
 SupportSpec = Union[str, Sequence[str]]
 
@@ -428,14 +431,6 @@ class BridgeModel:
             w2, phi = spla.eigsh(self.K_ff, k=count, M=self.M_ff, sigma=0.0, which="LM")
             order = np.argsort(w2)
             w2, phi = w2[order], phi[:, order]
-        # A mechanism shows up as an eigenvalue at round-off level compared with
-        # the stiffest element-level ratio K_ii / M_ii.
-        scale = float(np.max(self.K_ff.diagonal() / self.M_ff.diagonal()))
-        if w2[0] <= 1e-10 * scale:
-            raise ModelError(
-                "the bridge has a rigid-body mode: its supports leave it free to move "
-                "(for example no twist or no axial restraint anywhere)"
-            )
         omega = np.sqrt(np.maximum(w2, 0.0))
         # Normalise each mode so its largest deflection is positive (repeatable signs).
         for j in range(phi.shape[1]):
@@ -476,15 +471,46 @@ class BridgeModel:
         return shares, kinds, dominant
 
     def _participation(self, phi_free: np.ndarray) -> dict[str, np.ndarray]:
+        """Effective modal mass fractions ``(phi^T M r)^2 / (r^T M r)`` per direction (docs/theory.md §4.6).
+
+        ``r`` moves every node, the supports included, rigidly in the direction
+        (base excitation): the free DOFs' mass coupling to the supports' DOFs
+        (``M_fs r_s``) belongs in ``phi^T M r``; leaving it out overstates the
+        first vertical mode of a simply supported beam (0.830 instead of 8/pi^2).
+        """
         out = {}
-        dof_kind = np.tile(np.arange(NODE_DOFS), self.n_nodes)[self.free]
+        dof_kind = np.tile(np.arange(NODE_DOFS), self.n_nodes)
+        phi = self.expand(phi_free)  # zero at restrained DOFs
         for direction, dof in (("vertical", "w"), ("lateral", "v"), ("axial", "u"), ("torsion", "theta_x")):
             r = (dof_kind == DOF_INDEX[dof]).astype(float)
-            m_r = self.M_ff @ r
+            m_r = self.M @ r
             total = r @ m_r
             # Mass-normalised shapes: effective mass = (phi^T M r)^2.
-            out[direction] = (phi_free.T @ m_r) ** 2 / total if total > 0 else np.zeros(phi_free.shape[1])
+            out[direction] = (phi.T @ m_r) ** 2 / total if total > 0 else np.zeros(phi.shape[1])
         return out
+
+    def check_no_mechanism(self) -> None:
+        """Raise ModelError when the supports leave the bridge free to move (a rigid-body mode).
+
+        Cholesky factor of the free stiffness ``K_ff = U^T U``: a mechanism makes
+        a pivot vanish. Each pivot is compared with its own diagonal entry
+        (``U_jj^2 / K_jj``), so the test depends neither on the density nor on
+        how fine the mesh is (a comparison of the lowest eigenvalue with the
+        largest ``K_ii / M_ii`` did, and refused sound light or finely meshed decks).
+        """
+        band = upper_band(self.K_ff)
+        diag = band[-1].copy()
+        try:
+            factor = scipy.linalg.cholesky_banded(band, lower=False, check_finite=False)
+        except np.linalg.LinAlgError:
+            ratio = 0.0
+        else:
+            ratio = float(np.min(factor[-1] ** 2 / diag))
+        if not ratio > MECHANISM_PIVOT:
+            raise ModelError(
+                "the bridge has a rigid-body mode: its supports leave it free to move "
+                "(for example no twist or no axial restraint anywhere); restrain more DOFs in `supports`"
+            )
 
 
 def _mesh(spans: Sequence[float], elements_per_span: Sequence[int]) -> np.ndarray:
@@ -578,6 +604,7 @@ def build_bridge(
         K=K,
         M=M,
     )
+    bridge.check_no_mechanism()
     if damping is None:
         return bridge
     if isinstance(damping, ExplicitDamping):
