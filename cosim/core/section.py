@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import functools
 import math
-from typing import Any
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
