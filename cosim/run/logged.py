@@ -46,7 +46,8 @@ from cosim.core.bridge import BridgeModel, ModalResult
 from cosim.core.section import SectionProperties
 from cosim.core.simulation import SimulationResult, simulate
 from cosim.errors import ConfigError, CosimError, LogError, ModelError, SumoError
-from cosim.log.writer import (
+from cosim.log.reader import read_log, traffic_from_log
+from cosim.log.schemas import (
     EVENTS_SCHEMA,
     PROFILE,
     STATUS_SCHEMA,
@@ -57,12 +58,8 @@ from cosim.log.writer import (
     TOPIC_VEHICLE_TYPES,
     TOPIC_VEHICLES,
     VEHICLE_ITEM,
-    BlockLogger,
-    LogRecorder,
-    TrafficLogger,
-    read_log,
-    traffic_from_log,
 )
+from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 
 from .scenario import Scenario, parse_scenario
 

@@ -13,7 +13,7 @@ from cosim.core.simulation import Sensor, SolverSettings, simulate
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.core.vehicles import QuarterCar
 from cosim.errors import LogError
-from cosim.log.writer import (
+from cosim.log import (
     TOPIC_EVENTS,
     TOPIC_SENSORS,
     TOPIC_STATUS,
