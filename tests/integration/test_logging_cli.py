@@ -24,9 +24,10 @@ import tomllib
 from _cli import TWO_CARS, cli_env, cosim_cli
 
 import cosim
-from cosim.log.writer import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
-from cosim.run.logged import toml_dumps
+from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
 from cosim.run.scenario import load_scenario
+from cosim.run.simulate import simulate_scenario
+from cosim.run.toml_writer import toml_dumps
 
 # A 20 m span with explicit constants (fast to build): a quarter-car along +x
 # and a golden car along -x on a class H road (the light wheels lift off),
@@ -85,7 +86,7 @@ def test_the_log_holds_the_run_exactly_and_is_self_contained(cars_log: Path) -> 
     log = read_log(cars_log)
     assert not log.truncated and log.final_status["state"] == "finished"
     # The sensor channels are the simulation's own samples, float for float (t = 0 at rest included).
-    expected = load_scenario(cars_log.parent / "cars.toml").simulate()
+    expected = simulate_scenario(load_scenario(cars_log.parent / "cars.toml"))
     samples = log.topic(TOPIC_SENSORS)
     np.testing.assert_array_equal([m["t"] for m in samples], expected.t)
     for name, values in expected.sensors.items():
