@@ -339,7 +339,8 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--scheduler", metavar="ADDRESS",
                        help="submit to an existing Dask scheduler (tcp://HOST:PORT) instead of a local cluster; "
                             "its workers need cosim and the output folder at the same path")
-    study.add_argument("--out", metavar="FOLDER", help="the output folder (default: [study].output, else studies/<name>)")
+    study.add_argument("--out", metavar="FOLDER",
+                       help="the output folder (default: [study].output, else studies/<name>)")
     study.add_argument("--redo", action="store_true", help="run every run again, even those already done")
     study.add_argument("--no-plots", action="store_true", help="write the table only")
     study.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")

@@ -46,6 +46,7 @@ NO_VEHICLES = (
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """With vehicles or traffic: the logged time simulation and its summary; without: modes and a static case."""
     if args.out is not None and Path(args.out).suffix.lower() == ".csv":
         raise CosimError(
             f"{args.out}: --out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv {args.out}"
@@ -375,6 +376,7 @@ def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
 
 
 def cmd_replay(args: argparse.Namespace) -> int:
+    """Re-drive the log's bridge (or ``--scenario``'s) with its traffic, logged; compare the sensors."""
     other = load_scenario(args.scenario) if args.scenario is not None else None
     log = Path(args.log)
     with tempfile.TemporaryDirectory(prefix="cosim-replay-") as scratch:

@@ -16,6 +16,7 @@ EXIT_INTERRUPTED = 130
 
 
 def scenario_line(scenario: Scenario) -> str:
+    """``Scenario: <name>``, with the file it came from unless it is a bundled one."""
     if scenario.source == scenario.title:  # a bundled scenario, named by its name
         return f"Scenario: {scenario.title}"
     return f"Scenario: {scenario.title} ({scenario.source})"
@@ -27,6 +28,7 @@ def _fixed(value: float, digits: int = 4) -> str:
 
 
 def section_lines(section: SectionProperties) -> list[str]:
+    """The section constants, one per line, with their units."""
     return [
         f"Section: {section.source}",
         f"  A      = {section.A:.6g} m^2",
@@ -44,6 +46,7 @@ def section_lines(section: SectionProperties) -> list[str]:
 
 
 def damping_lines(bridge: BridgeModel) -> list[str]:
+    """The Rayleigh coefficients and how they were chosen (or "none")."""
     if bridge.alpha == 0 and bridge.beta == 0:
         return ["Damping: none (undamped)"]
     return [
@@ -53,6 +56,7 @@ def damping_lines(bridge: BridgeModel) -> list[str]:
 
 
 def modes_lines(modal: ModalResult) -> list[str]:
+    """A table of the modes: frequency, kind and effective modal mass fractions."""
     part = modal.participation
     lines = [
         "Modes (effective modal mass fractions)",

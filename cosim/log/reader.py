@@ -181,16 +181,6 @@ class LogOverview:
         status = self.final_status or {}
         return str(status.get("state", "unknown")) + ("" if self.complete else " (truncated)")
 
-    def attachment_json(self, name: str) -> Any:
-        """A JSON attachment of the log, or None (missing or not JSON)."""
-        raw = self.attachments.get(name)
-        if raw is None:
-            return None
-        try:
-            return json.loads(raw)
-        except ValueError:
-            return None
-
 
 def open_log(path: str | os.PathLike[str]) -> LogOverview:
     """Read a log's metadata, attachments, message counts and final status (not the messages).

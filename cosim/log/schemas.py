@@ -36,8 +36,6 @@ METADATA_NAME = "cosim"
 REPLAY_METADATA_NAME = "replay"
 #: The attachment holding the scenario's TOML text exactly as it was read.
 SCENARIO_ATTACHMENT = "scenario.toml"
-#: Documents derived from the scenario, attached as JSON.
-DERIVED_ATTACHMENTS = ("resolved.json", "section.json", "modes.json")
 
 _NUMBER = {"type": "number"}
 

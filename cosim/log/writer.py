@@ -457,8 +457,8 @@ class BlockLogger:
         shape = (len(steps), len(ids))
         columns = []
         for name in VEHICLE_NUMBERS:  # per step and vehicle, or per vehicle (the lateral offset)
-            values = getattr(report, _REPORT_ARRAYS.get(name, name))
-            columns.append(values[steps] if values.ndim == 2 else np.broadcast_to(values, shape))
+            array = getattr(report, _REPORT_ARRAYS.get(name, name))
+            columns.append(array[steps] if array.ndim == 2 else np.broadcast_to(array, shape))
         fields = np.stack(columns, axis=2)  # (samples, vehicles, numeric fields)
         width_per_vehicle = len(VEHICLE_NUMBERS)
         t = times[steps]
@@ -469,9 +469,9 @@ class BlockLogger:
         for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
             cols = np.flatnonzero(on[lo])
             template = self._vehicle_template(tuple(ids[j] for j in cols))
-            values = np.column_stack([t[lo:hi], fields[lo:hi][:, cols, :].reshape(hi - lo, width_per_vehicle * len(cols))])
-            tokens = _number_tokens(values)
             width = 1 + width_per_vehicle * len(cols)
+            values = np.column_stack([t[lo:hi], fields[lo:hi][:, cols, :].reshape(hi - lo, width - 1)])
+            tokens = _number_tokens(values)
             out[lo:hi] = [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)]
         self.rec.write_encoded(TOPIC_VEHICLES, t.tolist(), out)
 
