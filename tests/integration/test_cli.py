@@ -51,12 +51,15 @@ def test_help_exits_zero_and_describes_options(args: tuple[str, ...], mentions: 
 
 def test_python_m_cosim_is_the_command_line_with_its_exit_statuses(tmp_path: Path) -> None:
     """A real process: ``python -m cosim`` exits with main's status and prints errors on one line."""
-    version = cosim_process("--version")
-    assert version.returncode == 0 and version.stdout.strip() == f"cosim {cosim.__version__}"
     result = cosim_process("modes", str(tmp_path / "missing.toml"))
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr.startswith(f"cosim: error: {tmp_path / 'missing.toml'}: no such scenario file")
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+def test_version() -> None:
+    result = cosim_cli("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"cosim {cosim.__version__}"
 
 
 def test_no_command_is_a_usage_error() -> None:
