@@ -49,6 +49,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cosim.core.bridge import BridgeModel
+from cosim.core.fields import VEHICLE_NUMBERS
 from cosim.core.quasistatic import QuasiStaticResult, quasi_static
 from cosim.errors import ConfigError
 from cosim.run.scenario import Scenario, load_scenario, parse_scenario
@@ -112,7 +113,7 @@ def _base(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None
     if base is None:
         return {}, "<test scenario>", Path.cwd()
     if isinstance(base, Scenario):
-        return tomllib.loads(base.text), base.source, Path(base._base_dir)  # noqa: SLF001 - same package
+        return tomllib.loads(base.text), base.source, base.base_dir
     if isinstance(base, Mapping):
         return _merge({}, base), "<test scenario>", Path.cwd()
     text = os.fspath(base)
@@ -122,7 +123,7 @@ def _base(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None
         except tomllib.TOMLDecodeError as exc:
             raise ConfigError(f"<test scenario>: TOML syntax error: {exc}") from None
     loaded = load_scenario(text)
-    return tomllib.loads(loaded.text), loaded.source, Path(loaded._base_dir)  # noqa: SLF001
+    return tomllib.loads(loaded.text), loaded.source, loaded.base_dir
 
 
 def scenario(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = None,
@@ -142,7 +143,7 @@ def scenario(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None 
         return base
     data, source, folder = _base(base)
     data = _merge(data, overrides)
-    from cosim.run.logged import toml_dumps
+    from cosim.run.toml_writer import toml_dumps
 
     try:
         text = toml_dumps(data)
@@ -271,8 +272,10 @@ class Results:
 
     # ------------------------------------------------------------- vehicles
     def vehicle(self, vehicle_id: str) -> dict[str, npt.NDArray[np.float64]]:
-        """One vehicle's samples while on the deck: ``t``, ``x``, ``y``, ``speed``, ``contact_force`` (N),
-        ``body_displacement`` (m), ``body_acceleration`` (m/s^2)."""
+        """One vehicle's samples while on the deck, named as in the log (:data:`VEHICLE_COLUMNS`): ``t``,
+        ``x``, ``y`` (m), ``speed`` (m/s), ``acceleration`` (m/s^2), ``body_displacement`` (m),
+        ``body_acceleration`` (m/s^2), ``contact_force`` (N, compression positive). An in-memory run has
+        the fields the simulation keeps (not ``acceleration``)."""
         table = self._vehicle_table()
         if vehicle_id not in table:
             raise KeyError(f"no vehicle {vehicle_id!r} on the deck (vehicles: {', '.join(table) or 'none'})")
@@ -301,17 +304,12 @@ class Results:
 
     def _traffic(self) -> Any:
         if self.log_path is not None:
-            from cosim.log.writer import (
-                TOPIC_TRAFFIC,
-                TOPIC_VEHICLE_TYPES,
-                read_log,
-                traffic_from_log,
-            )
+            from cosim.log.reader import read_traffic
 
             traffic_cfg = self.scenario.traffic
             if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)
-                contents = read_log(self.log_path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-                return traffic_from_log(contents, self.bridge.length, traffic_cfg.step, until=self.duration)
+                traffic, _ = read_traffic(self.log_path, self.bridge.length, traffic_cfg.step, until=self.duration)
+                return traffic
         return self.scenario.build_vehicles()
 
     def static(self, name: str) -> npt.NDArray[np.float64]:
@@ -333,11 +331,15 @@ class Results:
         return self.bridge.modes(count).f_hz
 
 
-def _vehicles_from_log(path: Path) -> dict[str, dict[str, npt.NDArray[np.float64]]]:
-    from cosim.log.writer import TOPIC_VEHICLES
-    from cosim.run.logged import iter_messages
+#: A vehicle's samples in :class:`Results`: the time and every numeric field of the log's vehicle items.
+VEHICLE_COLUMNS: tuple[str, ...] = ("t", *VEHICLE_NUMBERS)
 
-    columns = ("t", "x", "y", "speed", "acceleration", "contact_force", "body_displacement", "body_acceleration")
+
+def _vehicles_from_log(path: Path) -> dict[str, dict[str, npt.NDArray[np.float64]]]:
+    from cosim.log.reader import iter_messages
+    from cosim.log.schemas import TOPIC_VEHICLES
+
+    columns = VEHICLE_COLUMNS
     rows: dict[str, dict[str, list[float]]] = {}
     for _, msg in iter_messages(path, [TOPIC_VEHICLES]):
         for v in msg["vehicles"]:
@@ -356,8 +358,7 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
     vehicles = {}
     for vid in result.vehicle_ids:
         v = result.vehicle(vid)
-        vehicles[vid] = {"t": v["t"], "x": v["x"], "y": v["y"], "speed": v["speed"], "contact_force": v["contact_force"],
-                         "body_displacement": v["body_displacement"], "body_acceleration": v["body_acceleration"]}
+        vehicles[vid] = {name: v[name] for name in VEHICLE_COLUMNS}  # the in-memory run uses the log's names
     return Results(
         scenario=sc, t=result.t, channels=dict(result.sensors),
         quantities={s.name: s.quantity for s in sc.sensors},
@@ -369,7 +370,7 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
 
 
 def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel) -> Results:
-    from cosim.run.logged import sensor_series
+    from cosim.log.reader import sensor_series
 
     result = outcome.result
     t, series = sensor_series(outcome.log_path, [s.name for s in sc.sensors])
@@ -406,7 +407,9 @@ def run(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = Non
     sc = scenario(base, **overrides)
     model = bridge_model if bridge_model is not None else sc.build_bridge()
     if log is None and not _has_traffic(sc):
-        return _from_simulation(sc, sc.simulate(bridge=model), model)
+        from cosim.run.simulate import simulate_scenario
+
+        return _from_simulation(sc, simulate_scenario(sc, bridge=model), model)
     from cosim.run.logged import run_logged
 
     if log is not None:
@@ -476,9 +479,9 @@ def dominant_frequency(t: npt.ArrayLike, values: npt.ArrayLike, band: tuple[floa
 
 
 def _unit(result: Results, name: str) -> tuple[str, float]:
-    from cosim.run.logged import DISPLAY_UNITS
+    from cosim.run.units import display_unit
 
-    return DISPLAY_UNITS.get(result.quantities.get(name, ""), ("SI", 1.0))
+    return display_unit(result.quantities.get(name, ""))
 
 
 def assert_peak_below(result: Results, sensor: str, bound: float) -> None:
@@ -525,7 +528,7 @@ def assert_matches_log(result: Results, log_path: str | os.PathLike[str], rtol: 
     stored samples (the stored log is interpolated at the result's times when
     its times differ). Every channel compared must be in both.
     """
-    from cosim.run.logged import open_log, sensor_series
+    from cosim.log.reader import open_log, sensor_series
 
     stored_names = open_log(log_path).sensor_names
     names = list(sensors) if sensors is not None else list(result.channels)

@@ -1,140 +1,51 @@
-"""MCAP logs: topics and schemas (one place), a crash-safe recorder, and a reader.
-
-Every message is JSON with a JSON Schema, so Foxglove and the ``mcap`` CLI can
-read the logs. Log times are integer nanoseconds of *simulated* time. The
-scenario, the resolved parameters, section constants, frequencies and every
-input file are stored as attachments and metadata, so a log alone is enough
-to re-run.
+"""Writing cosim logs: a crash-safe MCAP recorder and the observers that stream a run into it.
 
 The writer (:class:`LogRecorder`) is a context manager: whatever ends the run
 (normal end, Ctrl-C, an exception) a final status message is written and the
 file is finished with its summary and index. A process killed outright
-leaves the chunks already flushed; :func:`read_log` reads those and says the
-file is truncated. Logs are parsed, never evaluated or unpickled.
+leaves the chunks already flushed; :mod:`cosim.log.reader` reads those and
+says the file is truncated.
+
+:class:`BlockLogger` streams the blocks of :func:`cosim.core.simulation.simulate`
+(sensor samples, vehicles on the deck, events, status) and
+:class:`TrafficLogger` the frames of a live traffic source (SUMO), so that a
+log can be replayed. Topics and schemas: :mod:`cosim.log.schemas`.
 """
 from __future__ import annotations
 
 import bisect
-import io
 import itertools
 import json
-import os
 import queue
 import struct
 import threading
 import time
 import traceback
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any, Iterable, Iterator
+from typing import IO, Any, Iterable
 
 import numpy as np
 import orjson
-from mcap.exceptions import McapError
 from mcap.opcode import Opcode
-from mcap.reader import make_reader
-from mcap.records import (
-    Attachment,
-    Channel,
-    Footer,
-    Header,
-    Message,
-    MessageIndex,
-    Metadata,
-)
-from mcap.stream_reader import StreamReader
+from mcap.records import MessageIndex
 from mcap.writer import CompressionType, Writer
 
 from cosim import __version__
-from cosim.core.traffic import Frame, FrameTraffic
-from cosim.core.vehicles import model_from_dict, model_to_dict
-from cosim.errors import ConfigError, LogError
+from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
+from cosim.core.vehicles import model_to_dict
+from cosim.errors import LogError
 
-PROFILE = "cosim"
-TOPIC_SENSORS = "/cosim/sensors"
-TOPIC_VEHICLES = "/cosim/vehicles"
-TOPIC_EVENTS = "/cosim/events"
-TOPIC_STATUS = "/cosim/status"
-TOPIC_TRAFFIC = "/cosim/traffic"
-TOPIC_VEHICLE_TYPES = "/cosim/vehicle_types"
-
-STATUS_STATES = ("started", "running", "finished", "interrupted", "error")
-EVENT_KINDS = ("entered", "left", "liftoff", "touchdown")
-
-_NUMBER = {"type": "number"}
-
-
-def sensors_schema(names: Iterable[str]) -> dict[str, Any]:
-    """Schema of one sensor sample: ``t`` (s) plus one number per sensor (SI unit of its quantity)."""
-    props: dict[str, Any] = {"t": {"type": "number", "description": "simulated time, s"}}
-    for name in names:
-        props[name] = _NUMBER
-    return {"title": "cosim.SensorSample", "type": "object", "properties": props,
-            "required": ["t", *names], "additionalProperties": False}
-
-
-VEHICLE_ITEM = {
-    "type": "object",
-    "properties": {
-        "id": {"type": "string"},
-        "model": {"type": "string"},
-        "x": {"type": "number", "description": "contact point along the axis, m"},
-        "y": {"type": "number", "description": "lateral offset, m"},
-        "speed": {"type": "number", "description": "along +x, m/s"},
-        "acceleration": {"type": "number", "description": "along +x, m/s^2"},
-        "body_displacement": {"type": "number", "description": "from static equilibrium, m"},
-        "body_acceleration": {"type": "number", "description": "m/s^2"},
-        "contact_force": {"type": "number", "description": "wheel on deck, compression positive, N"},
-    },
-    "required": ["id", "model", "x", "y", "speed", "acceleration", "body_displacement",
-                 "body_acceleration", "contact_force"],
-    "additionalProperties": False,
-}
-VEHICLES_SCHEMA = {
-    "title": "cosim.VehiclesOnDeck", "type": "object",
-    "properties": {"t": _NUMBER, "vehicles": {"type": "array", "items": VEHICLE_ITEM}},
-    "required": ["t", "vehicles"], "additionalProperties": False,
-}
-EVENTS_SCHEMA = {
-    "title": "cosim.TrafficEvent", "type": "object",
-    "properties": {"t": _NUMBER, "vehicle": {"type": "string"}, "event": {"enum": list(EVENT_KINDS)},
-                   "x": _NUMBER},
-    "required": ["t", "vehicle", "event"], "additionalProperties": False,
-}
-STATUS_SCHEMA = {
-    "title": "cosim.RunStatus", "type": "object",
-    "properties": {"t": _NUMBER, "state": {"enum": list(STATUS_STATES)}, "message": {"type": "string"},
-                   "progress": _NUMBER, "wall_time": _NUMBER},
-    "required": ["t", "state"], "additionalProperties": False,
-}
-TRAFFIC_SCHEMA = {
-    "title": "cosim.TrafficFrame", "type": "object",
-    "description": "Vehicles near the deck at one SUMO step (bridge coordinates): what replay re-drives.",
-    "properties": {
-        "t": _NUMBER,
-        "ids": {"type": "array", "items": {"type": "string"}},
-        "x": {"type": "array", "items": _NUMBER},
-        "y": {"type": "array", "items": _NUMBER},
-        "speed": {"type": "array", "items": _NUMBER},
-        "acceleration": {"type": "array", "items": _NUMBER},
-        "types": {"type": "array", "items": {"type": "string"}},
-    },
-    "required": ["t", "ids", "x", "y", "speed", "acceleration", "types"], "additionalProperties": False,
-}
-VEHICLE_TYPE_SCHEMA = {
-    "title": "cosim.VehicleType", "type": "object",
-    "description": "The vehicle model of a SUMO vType, logged when the type first appears.",
-    "properties": {"t": _NUMBER, "type": {"type": "string"},
-                   "model": {"type": "object", "properties": {"model": {"type": "string"}},
-                             "required": ["model"], "additionalProperties": {"type": "number"}}},
-    "required": ["t", "type", "model"], "additionalProperties": False,
-}
-
-
-def to_ns(t: float) -> int:
-    """Simulated time in seconds -> integer nanoseconds."""
-    return int(round(t * 1e9))
-
+from .schemas import (
+    PROFILE,
+    TOPIC_EVENTS,
+    TOPIC_SENSORS,
+    TOPIC_STATUS,
+    TOPIC_TRAFFIC,
+    TOPIC_VEHICLE_TYPES,
+    TOPIC_VEHICLES,
+    to_ns,
+    topic_schemas,
+)
 
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")  # opcode, record length, channel id, sequence, log time, publish time
 _MESSAGE_OPCODE = 0x05
@@ -260,15 +171,8 @@ class LogRecorder:
         self._sequence = 0
         self._closed = False
         self.final_state: str | None = None
-        for topic, title, schema in (
-            (TOPIC_SENSORS, "cosim.SensorSample", sensors_schema(self.sensor_names)),
-            (TOPIC_VEHICLES, "cosim.VehiclesOnDeck", VEHICLES_SCHEMA),
-            (TOPIC_EVENTS, "cosim.TrafficEvent", EVENTS_SCHEMA),
-            (TOPIC_STATUS, "cosim.RunStatus", STATUS_SCHEMA),
-            (TOPIC_TRAFFIC, "cosim.TrafficFrame", TRAFFIC_SCHEMA),
-            (TOPIC_VEHICLE_TYPES, "cosim.VehicleType", VEHICLE_TYPE_SCHEMA),
-        ):
-            sid = self._writer.register_schema(title, "jsonschema", json.dumps(schema).encode())
+        for topic, schema in topic_schemas(self.sensor_names):
+            sid = self._writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
             self._channels[topic] = self._writer.register_channel(topic, "json", sid)
         self._last_t = 0.0
         # The block logger's thread and the traffic source (main thread) both write.
@@ -349,116 +253,6 @@ class LogRecorder:
             self.close("error", f"{exc_type.__name__}: {exc}")
 
 
-# ------------------------------------------------------------------ reading
-@dataclass
-class LogContents:
-    """What a log holds. ``messages`` maps topic -> list of (log_time ns, decoded JSON)."""
-
-    path: Path
-    profile: str = ""
-    messages: dict[str, list[tuple[int, dict]]] = field(default_factory=dict)
-    attachments: dict[str, bytes] = field(default_factory=dict)
-    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
-    truncated: bool = False
-
-    @property
-    def final_status(self) -> dict | None:
-        status = self.messages.get(TOPIC_STATUS, [])
-        return status[-1][1] if status else None
-
-    def topic(self, name: str) -> list[dict]:
-        return [m for _, m in self.messages.get(name, [])]
-
-
-def _decode(path: Path, channel: Channel, data: bytes) -> dict:
-    if channel.message_encoding != "json":
-        raise LogError(f"{path}: channel {channel.topic} is {channel.message_encoding!r}, not a cosim JSON channel")
-    try:
-        return json.loads(data)
-    except (ValueError, UnicodeDecodeError):
-        raise LogError(f"{path}: a message on {channel.topic} is not valid JSON") from None
-
-
-def read_log(path: str | Path, topics: Iterable[str] | None = None) -> LogContents:
-    """Read a cosim log; a log cut short (process killed) is read up to its last complete chunk.
-
-    Raises:
-        LogError: the file is missing, not MCAP, or not a cosim log.
-    """
-    path = Path(path)
-    wanted = set(topics) if topics is not None else None
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise LogError(f"{path}: cannot read ({exc.strerror})") from None
-    if not raw.startswith(b"\x89MCAP0\r\n"):
-        raise LogError(f"{path}: not an MCAP file")
-    out = LogContents(path=path)
-    try:
-        reader = make_reader(io.BytesIO(raw), validate_crcs=True)
-        header = reader.get_header()
-        out.profile = header.profile
-        for _, channel, message in reader.iter_messages(topics=list(wanted) if wanted else None):
-            out.messages.setdefault(channel.topic, []).append((message.log_time, _decode(path, channel, message.data)))
-        for att in reader.iter_attachments():
-            out.attachments[att.name] = att.data
-        for meta in reader.iter_metadata():
-            out.metadata[meta.name] = dict(meta.metadata)
-    except (McapError, EOFError, ValueError, KeyError, OSError):
-        out = _read_stream(path, raw, wanted)
-    if out.profile != PROFILE:
-        raise LogError(f"{path}: an MCAP file, but not a cosim log (profile {out.profile!r})")
-    for msgs in out.messages.values():
-        msgs.sort(key=lambda item: item[0])
-    return out
-
-
-def _read_stream(path: Path, raw: bytes, wanted: set[str] | None) -> LogContents:
-    """Record-by-record read that stops at the first incomplete record (a truncated file)."""
-    out = LogContents(path=path, truncated=True)
-    channels: dict[int, Channel] = {}
-    records: Iterator = StreamReader(io.BytesIO(raw), validate_crcs=True).records
-    complete = False
-    try:
-        for record in records:
-            if isinstance(record, Header):
-                out.profile = record.profile
-            elif isinstance(record, Channel):
-                channels[record.id] = record
-            elif isinstance(record, Message):
-                channel = channels.get(record.channel_id)
-                if channel is not None and (wanted is None or channel.topic in wanted):
-                    out.messages.setdefault(channel.topic, []).append(
-                        (record.log_time, _decode(path, channel, record.data)))
-            elif isinstance(record, Attachment):
-                out.attachments[record.name] = record.data
-            elif isinstance(record, Metadata):
-                out.metadata[record.name] = dict(record.metadata)
-            elif isinstance(record, Footer):
-                complete = True
-    except LogError:
-        raise
-    except Exception:  # noqa: BLE001 - any malformed record ends the readable part of a cut-off file
-        pass
-    if not out.profile:
-        raise LogError(f"{path}: an MCAP file whose header cannot be read")
-    out.truncated = not complete
-    return out
-
-
-def file_is_complete(path: str | Path) -> bool:
-    """True when the log was finished (it ends with the MCAP footer and magic)."""
-    try:
-        with open(path, "rb") as fh:
-            fh.seek(0, os.SEEK_END)
-            if fh.tell() < 16:
-                return False
-            fh.seek(-8, os.SEEK_END)
-            return fh.read(8) == b"\x89MCAP0\r\n"
-    except OSError:
-        return False
-
-
 #: The block logger's writer thread waits this long at most for the solver's next block, s.
 PACE_TIMEOUT = 0.02
 #: ... and then this long, for the solver thread to enter its compiled (GIL-free) loop, s.
@@ -480,6 +274,10 @@ class _PacedTraffic:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.traffic, name)
+
+
+#: The :class:`cosim.core.coupling.BlockReport` array of a numeric vehicle field, where the names differ.
+_REPORT_ARRAYS = {"speed": "v", "acceleration": "a"}
 
 
 class BlockLogger:
@@ -626,17 +424,19 @@ class BlockLogger:
         for j, vid in enumerate(ids):
             self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
 
-    _VEHICLE_FIELDS = (b'%s,"y":%s,"speed":%s,"acceleration":%s,"body_displacement":%s,'
-                       b'"body_acceleration":%s,"contact_force":%s}')
+    def _vehicle_item(self, vid: str) -> bytes:
+        """``{"id":..,"model":..,"x":%s,...}``: one vehicle's item, its fields in :data:`VEHICLE_FIELDS` order."""
+        text = {"id": vid, "model": self._model_names[vid]}
+        parts = [_template_part(f.name) + b":" + (_template_part(text[f.name]) if f.json_type == "string" else b"%s")
+                 for f in VEHICLE_FIELDS]
+        return b"{" + b",".join(parts) + b"}"
 
     def _vehicle_template(self, ids: tuple[str, ...]) -> bytes:
         """``{"t":%s,"vehicles":[{"id":..,"model":..,"x":%s,...},...]}`` for these vehicles, in this order."""
         key = ids
         template = self._vehicle_templates.get(key)
         if template is None:
-            items = [b'{"id":' + _template_part(vid) + b',"model":' + _template_part(self._model_names[vid])
-                     + b',"x":' + self._VEHICLE_FIELDS for vid in ids]
-            template = b'{"t":%s,"vehicles":[' + b",".join(items) + b"]}"
+            template = b'{"t":%s,"vehicles":[' + b",".join(self._vehicle_item(vid) for vid in ids) + b"]}"
             if len(self._vehicle_templates) > 256:
                 self._vehicle_templates.clear()
             self._vehicle_templates[key] = template
@@ -654,9 +454,13 @@ class BlockLogger:
             return
         steps = kept[rows]
         on = on[rows]
-        fields = np.stack([report.x[steps], np.broadcast_to(report.y, (len(steps), len(ids))), report.v[steps],
-                           report.a[steps], report.body_displacement[steps], report.body_acceleration[steps],
-                           report.contact_force[steps]], axis=2)  # (samples, vehicles, 7)
+        shape = (len(steps), len(ids))
+        columns = []
+        for name in VEHICLE_NUMBERS:  # per step and vehicle, or per vehicle (the lateral offset)
+            array = getattr(report, _REPORT_ARRAYS.get(name, name))
+            columns.append(array[steps] if array.ndim == 2 else np.broadcast_to(array, shape))
+        fields = np.stack(columns, axis=2)  # (samples, vehicles, numeric fields)
+        width_per_vehicle = len(VEHICLE_NUMBERS)
         t = times[steps]
         out: list[bytes] = [b""] * len(steps)
         # Consecutive samples with the same vehicles on the deck share one template.
@@ -665,16 +469,17 @@ class BlockLogger:
         for lo, hi in zip(bounds[:-1].tolist(), bounds[1:].tolist()):
             cols = np.flatnonzero(on[lo])
             template = self._vehicle_template(tuple(ids[j] for j in cols))
-            values = np.column_stack([t[lo:hi], fields[lo:hi][:, cols, :].reshape(hi - lo, 7 * len(cols))])
+            width = 1 + width_per_vehicle * len(cols)
+            values = np.column_stack([t[lo:hi], fields[lo:hi][:, cols, :].reshape(hi - lo, width - 1)])
             tokens = _number_tokens(values)
-            width = 1 + 7 * len(cols)
             out[lo:hi] = [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)]
         self.rec.write_encoded(TOPIC_VEHICLES, t.tolist(), out)
+
 
 class TrafficLogger:
     """Frame sink for a live traffic source (SUMO): logs every frame with vehicles, and each new vehicle type.
 
-    These are what :func:`traffic_from_log` needs to re-drive a bridge with
+    These are what :func:`cosim.log.reader.traffic_from_log` needs to re-drive a bridge with
     exactly the same vehicle kinematics (``cosim replay``). A frame without
     vehicles near the deck is not written: a missing frame is an empty one.
     """
@@ -696,39 +501,7 @@ class TrafficLogger:
             "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
 
 
-def traffic_from_log(contents: LogContents, length: float, step: float, until: float | None = None) -> FrameTraffic:
-    """Rebuild the logged traffic frames as a traffic source for a bridge of ``length`` m.
-
-    Frames the log does not hold were empty (no vehicle near the deck); they
-    are filled in at their step times, up to ``until`` (s) if given.
-
-    Raises:
-        LogError: the log has no traffic frames (and no ``until``), or they are malformed.
-    """
-    frames = contents.topic(TOPIC_TRAFFIC)
-    if not frames and until is None:
-        raise LogError(f"{contents.path}: no traffic frames ({TOPIC_TRAFFIC}) in this log")
-    empty = np.zeros(0)
-
-    def pad(traffic: FrameTraffic, t_end: float) -> None:
-        """Empty frames while one more still ends before ``t_end`` (half a step of slack for round-off)."""
-        # Same time expression as the live source (k * step), so replays are bit-identical.
-        while traffic.last_time + step < t_end + 0.5 * step:
-            k = int(round(traffic.last_time / step)) + 1
-            traffic.add_frame(Frame(k * step, (), empty, empty, empty, empty, ()))
-
-    try:
-        models = {m["type"]: model_from_dict(m["model"]) for m in contents.topic(TOPIC_VEHICLE_TYPES)}
-        traffic = FrameTraffic(step, length, models)
-        for f in frames:
-            t = float(f["t"])
-            pad(traffic, t - step)
-            traffic.add_frame(Frame(
-                t=t, ids=tuple(f["ids"]), x=np.array(f["x"], dtype=float), y=np.array(f["y"], dtype=float),
-                v=np.array(f["speed"], dtype=float), a=np.array(f["acceleration"], dtype=float),
-                types=tuple(f["types"])))
-        if until is not None:
-            pad(traffic, until)
-    except (KeyError, TypeError, ValueError, ConfigError) as exc:
-        raise LogError(f"{contents.path}: malformed traffic frames ({exc})") from None
-    return traffic
+# --------------------------------------------------------------------------- compatibility (issue 9)
+# cosim.study and tests/integration/test_{sumo,studies}.py still import the reader from here; they
+# move to ``cosim.log`` when their owners update the call sites. Remove these three names then.
+from .reader import file_is_complete, read_log, traffic_from_log  # noqa: E402, F401

@@ -1,14 +1,45 @@
-"""Shared by the command-line tests: run ``python -m cosim`` against this checkout, and a small scenario."""
+"""Shared by the command-line tests: run the ``cosim`` command line in this process (or, where a real
+process is the point, as ``python -m cosim``), and a small scenario."""
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import subprocess
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import cosim
+from cosim.cli import main
 
 REPO = Path(cosim.__file__).resolve().parents[1]
+
+
+@dataclass(frozen=True)
+class CliResult:
+    """What a command left behind: its exit status and everything it printed."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+def cosim_cli(*args: str, cwd: Path | None = None) -> CliResult:
+    """``cosim ARGS`` in this process (:func:`cosim.cli.main`), in ``cwd`` (default: the checkout), with
+    stdout and stderr captured. Use :func:`cosim_process` where a real process is the point."""
+    out, err = io.StringIO(), io.StringIO()
+    previous = Path.cwd()
+    os.chdir(cwd or REPO)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                status = main(list(args))
+            except SystemExit as exc:  # main returns its status; a stray exit is still an exit status
+                status = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    finally:
+        os.chdir(previous)
+    return CliResult(status, out.getvalue(), err.getvalue())
 
 
 def cli_env() -> dict[str, str]:
@@ -19,8 +50,8 @@ def cli_env() -> dict[str, str]:
     return environ
 
 
-def cosim_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
-    """Run ``python -m cosim ARGS`` against this checkout in ``cwd`` (default: the checkout)."""
+def cosim_process(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess[str]:
+    """Run ``python -m cosim ARGS`` as a real process against this checkout in ``cwd`` (default: the checkout)."""
     return subprocess.run([sys.executable, "-m", "cosim", *args], capture_output=True, text=True,
                           cwd=cwd or REPO, env=cli_env(), timeout=300)
 

@@ -1,4 +1,5 @@
-"""The command line, run as users run it: ``python -m cosim ...`` in a subprocess."""
+"""The command line as users run it: its output and exit statuses (in this process through ``cosim.cli.main``),
+and ``python -m cosim`` as a real process."""
 from __future__ import annotations
 
 import json
@@ -23,7 +24,7 @@ def _without_vehicles(text: str) -> str:
 PAPER_STATIC_TEXT = _without_vehicles(PAPER_TEXT)
 
 
-from _cli import cosim_cli  # noqa: E402
+from _cli import cosim_cli, cosim_process  # noqa: E402
 
 # --------------------------------------------------------------------------- help
 
@@ -46,6 +47,19 @@ def test_help_exits_zero_and_describes_options(args: tuple[str, ...], mentions: 
     assert result.returncode == 0, result.stderr
     for word in mentions:
         assert word in result.stdout, word
+
+
+def test_python_m_cosim_is_the_command_line_with_its_exit_statuses(tmp_path: Path) -> None:
+    """A real process: ``python -m cosim`` exits with main's status and prints errors on one line."""
+    result = cosim_process("modes", str(tmp_path / "missing.toml"))
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr.startswith(f"cosim: error: {tmp_path / 'missing.toml'}: no such scenario file")
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+def test_version() -> None:
+    result = cosim_cli("--version")
+    assert result.returncode == 0 and result.stdout.strip() == f"cosim {cosim.__version__}"
 
 
 def test_no_command_is_a_usage_error() -> None:

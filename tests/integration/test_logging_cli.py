@@ -1,9 +1,9 @@
-"""MCAP logs through the command line, as users run it: real files, real subprocesses, real signals.
+"""MCAP logs through the command line, as users run it: real files, the commands in this process,
+and real processes for Ctrl-C (SIGINT) and SIGKILL in the middle of a run.
 
 ``cosim run`` -> log -> ``info`` / ``export`` / ``plot``; ``replay`` bit for bit
-and onto another bridge; Ctrl-C (SIGINT) and SIGKILL in the middle of a run;
-damaged and foreign files; overwrite refusal; every message of a real run
-against its JSON Schema.
+and onto another bridge; stopped runs; damaged and foreign files; overwrite
+refusal; every message of a real run against its JSON Schema.
 """
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ import sys
 import time
 from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import jsonschema
 import numpy as np
@@ -24,9 +25,10 @@ import tomllib
 from _cli import TWO_CARS, cli_env, cosim_cli
 
 import cosim
-from cosim.log.writer import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
-from cosim.run.logged import toml_dumps
+from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
 from cosim.run.scenario import load_scenario
+from cosim.run.simulate import simulate_scenario
+from cosim.run.toml_writer import toml_dumps
 
 # A 20 m span with explicit constants (fast to build): a quarter-car along +x
 # and a golden car along -x on a class H road (the light wheels lift off),
@@ -45,6 +47,16 @@ OTHER = (CARS.replace('name = "cars"', 'name = "other"').replace("spans = [20.0]
 # A run long enough to be stopped from outside: one slow car, 10 000 s, every step logged.
 LONG = (CARS.replace('name = "cars"', 'name = "long"').replace("speed = 25.0", "speed = 0.05")
         .replace("[solver]\ndt = 0.002", "[solver]\ndt = 0.002\nduration = 10000.0\n[output]\nevery = 1"))
+
+
+def schema_validator(text: bytes, cache: dict[bytes, Any]) -> Any:
+    """A JSON Schema validator for a schema record's text, checked and built once per schema."""
+    if text not in cache:
+        schema = json.loads(text)
+        cls = jsonschema.validators.validator_for(schema)
+        cls.check_schema(schema)
+        cache[text] = cls(schema)
+    return cache[text]
 
 
 def write(folder: Path, name: str, text: str) -> Path:
@@ -85,7 +97,7 @@ def test_the_log_holds_the_run_exactly_and_is_self_contained(cars_log: Path) -> 
     log = read_log(cars_log)
     assert not log.truncated and log.final_status["state"] == "finished"
     # The sensor channels are the simulation's own samples, float for float (t = 0 at rest included).
-    expected = load_scenario(cars_log.parent / "cars.toml").simulate()
+    expected = simulate_scenario(load_scenario(cars_log.parent / "cars.toml"))
     samples = log.topic(TOPIC_SENSORS)
     np.testing.assert_array_equal([m["t"] for m in samples], expected.t)
     for name, values in expected.sensors.items():
@@ -115,9 +127,10 @@ def test_every_message_validates_against_its_schema(cars_log: Path) -> None:
     counts: dict[str, int] = {}
     with open(cars_log, "rb") as fh:
         reader = make_reader(fh, validate_crcs=True)
+        validators: dict[bytes, Any] = {}
         for schema, channel, message in reader.iter_messages():
             assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
-            jsonschema.validate(json.loads(message.data), json.loads(schema.data))
+            schema_validator(schema.data, validators).validate(json.loads(message.data))
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
         summary = reader.get_summary()
     assert counts[TOPIC_SENSORS] == 401 and counts[TOPIC_VEHICLES] > 100 and counts[TOPIC_EVENTS] >= 4
@@ -320,6 +333,28 @@ def test_scenarios_survive_the_toml_writer() -> None:
         assert tomllib.loads(toml_dumps(data)) == data
     odd = {"a b": "quote \" and \\ and \x7f", "x": [1, 2.5e-300, -0.0], "t": {"inner": [{"k": True}, {"k": False}]}}
     assert tomllib.loads(toml_dumps(odd)) == odd
+
+
+def test_outputs_are_written_whole_or_not_at_all(tmp_path: Path) -> None:
+    from cosim.errors import CosimError
+    from cosim.run.outputs import atomic_write
+
+    target = write(tmp_path, "out.csv", "old\n")
+    with pytest.raises(RuntimeError):
+        with atomic_write(target, "CSV") as partial:
+            partial.write_text("half")
+            raise RuntimeError("interrupted while writing")
+    assert target.read_text() == "old\n" and sorted(p.name for p in tmp_path.iterdir()) == ["out.csv"]
+    with atomic_write(tmp_path / "new" / "out.csv", "CSV") as partial:
+        assert partial.parent == tmp_path / "new" and partial.suffix == ".csv"  # same folder, same format
+        partial.write_text("whole\n")
+    assert (tmp_path / "new" / "out.csv").read_text() == "whole\n" and len(list((tmp_path / "new").iterdir())) == 1
+    blocked = tmp_path / "new" / "folder.csv"
+    write(blocked, "inside.txt", "")  # a folder where the file should go: the final rename fails
+    with pytest.raises(CosimError, match="folder.csv: cannot write the CSV"):
+        with atomic_write(blocked, "CSV") as partial:
+            partial.write_text("whole\n")
+    assert sorted(p.name for p in (tmp_path / "new").iterdir()) == ["folder.csv", "out.csv"]
 
 
 def test_the_foxglove_layout_ships_with_the_package() -> None:

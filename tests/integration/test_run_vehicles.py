@@ -10,9 +10,9 @@ import pytest
 from _cli import TWO_CARS, cosim_cli
 
 from cosim import cli
-from cosim.cli import app as cli_main
+from cosim.cli import run as cli_run
 from cosim.errors import ModelError
-from cosim.log.writer import TOPIC_SENSORS, read_log
+from cosim.log import TOPIC_SENSORS, read_log
 from cosim.run import logged as runner
 
 # The shared two cars without ids (they are V1, V2 by position) and sampled every 5th step.
@@ -202,7 +202,7 @@ def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
 
     terminal = Terminal()
     monkeypatch.setattr("sys.stderr", terminal)
-    progress = cli_main._Progress(20.0, show=True)
+    progress = cli_run.Progress(20.0, show=True)
     progress(0.5)
     progress(1.0)
     progress.close()
@@ -211,7 +211,7 @@ def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
 
     quiet = Terminal()
     monkeypatch.setattr("sys.stderr", quiet)
-    progress = cli_main._Progress(20.0, show=False)
+    progress = cli_run.Progress(20.0, show=False)
     progress(1.0)
     progress.close()
     assert quiet.getvalue() == ""

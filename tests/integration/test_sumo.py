@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from cosim.core.bridge import PointLoad
-from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.vehicles import QuarterCar
 from cosim.errors import SumoError
 from cosim.run.scenario import load_scenario

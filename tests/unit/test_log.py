@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from typing import Any
 
 import jsonschema
 import numpy as np
@@ -9,11 +10,12 @@ import pytest
 
 from cosim.core.bridge import build_bridge
 from cosim.core.section import Material, SectionProperties
-from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.core.vehicles import QuarterCar
 from cosim.errors import LogError
-from cosim.log.writer import (
+from cosim.log import (
     TOPIC_EVENTS,
     TOPIC_SENSORS,
     TOPIC_STATUS,
@@ -28,6 +30,16 @@ MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_s=0.0, z_s=0.0,
                         J=0.15, I_w=19.0, A_sy=2.5, A_sz=0.9, deck_y=(-6.6, 6.6))
 SENSORS = [Sensor("mid", 15.0, 0.0), Sensor("edge_acc", 15.0, 6.0, "acceleration")]
+
+
+def schema_validator(text: bytes, cache: dict[bytes, Any]) -> Any:
+    """A JSON Schema validator for a schema record's text, checked and built once per schema."""
+    if text not in cache:
+        schema = json.loads(text)
+        cls = jsonschema.validators.validator_for(schema)
+        cls.check_schema(schema)
+        cache[text] = cls(schema)
+    return cache[text]
 
 
 def _logged_run(path, duration=2.0, **kwargs):
@@ -69,10 +81,11 @@ def test_every_message_validates_against_its_schema(tmp_path):
     _logged_run(path)
     with open(path, "rb") as fh:
         reader = make_reader(fh, validate_crcs=True)
+        validators: dict[bytes, Any] = {}
         count = 0
         for schema, channel, message in reader.iter_messages():
             assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
-            jsonschema.validate(json.loads(message.data), json.loads(schema.data))
+            schema_validator(schema.data, validators).validate(json.loads(message.data))
             count += 1
     assert count > 100
 
@@ -125,3 +138,55 @@ def test_vehicle_messages_carry_the_contact_forces(tmp_path):
     expected = result.vehicle("a")["contact_force"]
     np.testing.assert_array_equal(np.array(forces), expected[np.isin(result.vehicle("a")["t"], [f["t"] for f in frames])])
     assert len(read_log(path).topic(TOPIC_STATUS)) >= 2
+
+
+def test_the_vehicle_schema_follows_the_recorded_fields():
+    """The /cosim/vehicles item is derived from VEHICLE_FIELDS and keeps the layout logs have always had."""
+    from cosim.core.fields import VEHICLE_FIELDS
+    from cosim.log.schemas import VEHICLE_ITEM
+
+    names = ["id", "model", "x", "y", "speed", "acceleration", "body_displacement", "body_acceleration",
+             "contact_force"]
+    assert list(VEHICLE_ITEM["properties"]) == names == [f.name for f in VEHICLE_FIELDS]
+    assert VEHICLE_ITEM["required"] == names and VEHICLE_ITEM["additionalProperties"] is False
+    types = {name: prop["type"] for name, prop in VEHICLE_ITEM["properties"].items()}
+    assert types == {name: "string" if name in ("id", "model") else "number" for name in names}
+    assert VEHICLE_ITEM["properties"]["contact_force"]["description"] == "wheel on deck, compression positive, N"
+
+
+def test_one_reader_whole_streamed_and_overview_agree_on_finished_and_cut_files(tmp_path):
+    from cosim.log import iter_messages, open_log
+
+    path = tmp_path / "run.mcap"
+    _logged_run(path, duration=6.0, chunk_size=16 * 1024)
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(path.read_bytes()[: path.stat().st_size * 2 // 3])
+    for log_path, complete in ((path, True), (cut, False)):
+        whole = read_log(log_path)
+        overview = open_log(log_path)
+        assert overview.complete is complete and whole.truncated is (not complete)
+        assert overview.counts == {topic: len(msgs) for topic, msgs in whole.messages.items()}
+        assert overview.final_status == whole.final_status and overview.attachments == whole.attachments
+        assert overview.end_time == max(ns for msgs in whole.messages.values() for ns, _ in msgs) / 1e9
+        streamed = [msg for _, msg in iter_messages(log_path, [TOPIC_SENSORS])]
+        assert streamed == whole.topic(TOPIC_SENSORS)
+    assert overview.status_word == "started (truncated)"  # cut before its first "running" status (every 10 s)
+
+
+def test_damage_in_a_finished_log_is_an_error_for_every_reader(tmp_path):
+    from mcap.reader import make_reader
+
+    from cosim.log import iter_messages, open_log
+
+    path = tmp_path / "run.mcap"
+    _logged_run(path, duration=2.0)
+    with open(path, "rb") as fh:
+        chunk = make_reader(fh).get_summary().chunk_indexes[0]
+    raw = bytearray(path.read_bytes())
+    middle = chunk.chunk_start_offset + chunk.chunk_length // 2
+    raw[middle:middle + 64] = bytes(64)
+    damaged = tmp_path / "damaged.mcap"
+    damaged.write_bytes(bytes(raw))
+    for read in (read_log, open_log, lambda p: list(iter_messages(p, [TOPIC_SENSORS]))):
+        with pytest.raises(LogError, match="corrupt MCAP file"):
+            read(damaged)

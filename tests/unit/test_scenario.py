@@ -15,6 +15,7 @@ from cosim.run.scenario import (
     load_scenario,
     parse_scenario,
 )
+from cosim.run.simulate import simulate_scenario
 
 REPO = Path(__file__).resolve().parents[2]
 BUNDLED = REPO / "cosim" / "scenarios"
@@ -874,7 +875,7 @@ def test_simulate_runs_the_scenario(tmp_path: Path) -> None:
     text = VEHICLES_TEXT + '[road]\nclass = "B"\nseed = 1\n[solver]\ndt = 0.01\nduration = 2.0\n[output]\nevery = 2\n'
     scenario = load_scenario(write(tmp_path, text, "cars.toml"))
     seen: list[float] = []
-    result = scenario.simulate(progress=seen.append)
+    result = simulate_scenario(scenario, progress=seen.append)
     assert result.steps == 200
     assert len(result.t) == 101 and result.t[-1] == pytest.approx(2.0)  # every 2nd step and t = 0
     assert list(result.sensors) == ["mid"]

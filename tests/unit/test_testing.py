@@ -141,3 +141,15 @@ def test_comparison_with_a_stored_log(girder, tmp_path):
         ct.assert_matches_log(heavier, stored, rtol=0.01, sensors=["mid"])
     with pytest.raises(AssertionError, match="channel.s. nope missing"):
         ct.assert_matches_log(heavier, stored, sensors=["nope"])
+
+
+def test_vehicle_samples_are_named_as_in_the_log(girder, tmp_path):
+    from cosim.core.fields import VEHICLE_NUMBERS
+
+    sc, model = girder
+    from_log = ct.run(sc, log=tmp_path / "run.mcap", bridge_model=model).vehicle("car")
+    in_memory = ct.run(sc, bridge_model=model).vehicle("car")
+    assert list(from_log) == ["t", *VEHICLE_NUMBERS]  # the log's fields, the log's names ("speed")
+    assert {"t", "x", "y", "speed", "contact_force", "body_acceleration"} <= set(in_memory) <= set(from_log)
+    for name, values in in_memory.items():  # the same samples, float for float
+        np.testing.assert_array_equal(values, from_log[name], err_msg=name)

@@ -7,7 +7,8 @@ import pytest
 from cosim.core.bridge import build_bridge
 from cosim.core.roughness import iso8608_profile
 from cosim.core.section import Material, SectionProperties
-from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar
 from cosim.errors import ConfigError

@@ -1,0 +1,90 @@
+"""``cosim export``, ``cosim info`` and ``cosim plot``: what is in a log, as CSV, text or a figure."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from cosim.log.reader import LogOverview, open_log
+from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_SENSORS
+from cosim.run.export import export_csv
+from cosim.run.figures import plot_log_sensors
+
+from .text import fmt_g, print_lines, size_text
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    """Write a topic of a log as CSV."""
+    overview = open_log(args.log)
+    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force)
+    if overview.truncated:
+        print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
+              file=sys.stderr)
+    units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
+    print(f"Wrote {rows} rows of {args.topic} to {args.csv} (columns {','.join(columns)}; {units})")
+    return 0
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    """Summarise a log."""
+    print_lines(info_lines(open_log(args.log)))
+    return 0
+
+
+def info_lines(o: LogOverview) -> list[str]:
+    """The lines of ``cosim info``."""
+    info = o.info
+    lines = [f"Log: {o.path} ({size_text(o.size)}, {'finished file' if o.complete else 'TRUNCATED'})"]
+    if info:
+        lines.append(f"Scenario: {info.get('scenario', '?')} (source: {info.get('source', '?')})")
+        lines.append(f"Written by: cosim {info.get('version', '?')} ({info.get('kind', 'run')}), "
+                     f"started {info.get('started', '?')}")
+        replay = o.metadata.get(REPLAY_METADATA_NAME)
+        if replay:
+            lines.append(f"Replay of: {replay.get('log', '?')} (traffic of {replay.get('log_scenario', '?')}; "
+                         f"bridge of {replay.get('scenario', '?')})")
+        every = info.get("every", "?")
+        steps = "every step" if every == "1" else f"every {every} steps"
+        rate = fmt_g(float(info["rate_hz"]), 4) if "rate_hz" in info else "?"
+        lines.append(f"Solver: {info.get('scheme', '?')}, {info.get('basis', '?')} basis, "
+                     f"dt = {info.get('dt', '?')} s; logged at {rate} Hz ({steps})")
+        planned = info.get("duration")
+        planned_text = f" of {fmt_g(float(planned), 6)} s" if planned else ""
+        lines.append(f"Simulated: {fmt_g(o.end_time, 6)} s{planned_text}")
+    else:
+        lines.append("Scenario: (no cosim metadata in this log)")
+        lines.append(f"Simulated: {fmt_g(o.end_time, 6)} s")
+    sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
+    lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
+    if "vehicles" in info:
+        try:
+            vehicles = json.loads(info["vehicles"])
+            lines.append(f"Vehicles ({len(vehicles)}): {', '.join(vehicles) or 'none'}")
+        except ValueError:
+            pass
+    lines.append("Topics:")
+    width = max([len(t) for t in o.counts] + [10])
+    for topic, count in sorted(o.counts.items()):
+        lines.append(f"  {topic:<{width}}  {count:>9} messages")
+    status = o.final_status
+    if status is None:
+        lines.append("Status: none logged")
+    else:
+        message = f": {status['message']}" if status.get("message") else ""
+        lines.append(f"Status: {status.get('state', '?')} at t = {fmt_g(float(status.get('t', 0.0)), 6)} s{message}")
+    if o.complete:
+        lines.append("Truncated: no")
+    else:
+        lines.append("Truncated: yes - the file was cut short (the process was killed?); "
+                     "it is read up to its last complete chunk")
+    atts = ", ".join(f"{name} ({size_text(len(data))})" for name, data in o.attachments.items()) or "none"
+    lines.append(f"Attachments: {atts}")
+    return lines
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    """Draw a log's sensor time histories."""
+    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force)
+    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)}) "
+          f"to {args.output}")
+    return 0

@@ -1,0 +1,41 @@
+"""``cosim modes``: a scenario's section constants, damping and natural modes (a table, JSON or a figure)."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from cosim import plots
+from cosim.run.figures import plot_modes
+from cosim.run.outputs import check_writable
+from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
+from cosim.run.scenario import load_scenario
+
+from .text import damping_lines, modes_lines, print_lines, scenario_line, section_lines
+
+
+def cmd_modes(args: argparse.Namespace) -> int:
+    """Print the modes of a scenario's bridge (``--json``: only JSON); ``--plot`` draws the first shapes."""
+    if args.plot:
+        check_writable(args.plot, "plot", plots.figure_formats())
+    scenario = load_scenario(args.scenario)
+    bridge = scenario.build_bridge()
+    modal = bridge.modes(count=args.count)
+    if args.json:
+        payload = {
+            "scenario": scenario.title,
+            "source": scenario.source,
+            "modes": modes_payload(modal),
+            "section": section_payload(bridge.section),
+            "damping": damping_payload(bridge),
+        }
+        print(json.dumps(jsonable(payload), indent=2))
+    else:
+        print_lines([scenario_line(scenario), ""])
+        print_lines(section_lines(bridge.section))
+        print_lines(["", *damping_lines(bridge), ""])
+        print_lines(modes_lines(modal))
+    if args.plot:
+        plotted = plot_modes(bridge, modal, args.plot, args.count)
+        if not args.json:
+            print(f"\nWrote {plotted} mode shape(s) to {args.plot}")
+    return 0

@@ -1,0 +1,19 @@
+"""``cosim validate``: the verification and validation cases with their report (the work is :mod:`cosim.validation`)."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .text import EXIT_RUN_FAILED, print_lines
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from cosim.validation.cases import run_validation
+
+    def progress(done: int, total: int, label: str) -> None:
+        print(f"[{done}/{total}] {label}", file=sys.stderr, flush=True)
+
+    report = run_validation(Path(args.out), quick=args.quick, progress=progress)
+    print_lines(report.summary_lines())
+    return 0 if report.all_passed else EXIT_RUN_FAILED

@@ -1,0 +1,67 @@
+"""The input files a scenario refers to (road profile, SUMO config and the files it names).
+
+A log carries them as attachments, so that it can be replayed without the
+originals (:mod:`cosim.run.logged`, :mod:`cosim.run.replay`).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+
+from cosim.errors import ConfigError
+
+from .scenario import Scenario
+
+
+@dataclass(frozen=True)
+class InputFile:
+    """A file the scenario refers to: its dotted key, the path as written, the file, and its attachment name."""
+
+    key: str
+    written: str
+    path: Path
+    attachment: str
+
+
+def input_files(scenario: Scenario) -> list[InputFile]:
+    """The scenario's input files (now: the road profile), with the names they get in a log.
+
+    A relative path inside the scenario's folder keeps its name (``data/road.csv``);
+    any other path is stored as ``inputs/<file name>``.
+    """
+    found = []
+    profile = scenario.road_profile_path
+    if profile is not None and scenario.road.profile is not None:
+        written = scenario.road.profile
+        pure = PurePosixPath(written.replace("\\", "/"))
+        safe = not pure.is_absolute() and ".." not in pure.parts and not re.match(r"^[A-Za-z]:", written)
+        name = str(pure) if safe else f"inputs/{pure.name}"
+        found.append(InputFile("road.profile", written, profile, name))
+    sumo_cfg = scenario.sumo_config_path
+    if sumo_cfg is not None:
+        for path in sumo_input_files(sumo_cfg):
+            rel = path.relative_to(sumo_cfg.parent) if path.is_relative_to(sumo_cfg.parent) else Path(path.name)
+            # Only the config is a scenario key; the files it names travel along as plain attachments.
+            key = "traffic.sumo_config" if path == sumo_cfg else ""
+            found.append(InputFile(key, str(path), path, f"sumo/{rel.as_posix()}"))
+    return found
+
+
+def sumo_input_files(config: Path) -> list[Path]:
+    """The SUMO config and the net, route and additional files it names (parsed as XML, never run)."""
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(config).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise ConfigError(f"{config}: not a readable SUMO config ({exc})") from None
+    files = [config]
+    for tag in ("net-file", "route-files", "additional-files"):
+        for element in root.iter(tag):
+            for name in element.get("value", "").split(","):
+                if name.strip():
+                    path = (config.parent / name.strip())
+                    if path.is_file() and path not in files:
+                        files.append(path)
+    return files

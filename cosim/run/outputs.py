@@ -1,0 +1,100 @@
+"""Output files: checked before the work, never overwritten silently, never left half written.
+
+- :func:`check_new_file`: fail *before* a run or an export when its output
+  cannot be created (it exists without ``force``, is a directory, a file
+  stands where a folder is needed);
+- :func:`check_writable`: the same for outputs that may be overwritten, in a folder that must exist;
+- :func:`unique_path`: a free default name (``run-2.mcap``, ...);
+- :func:`atomic_write`: write through a temporary file in the same folder,
+  flushed to disk and renamed over the target at the end; on any failure or
+  interruption the temporary file is removed and the target is untouched.
+
+MCAP logs are the exception: a run streams into its log in place, so that a
+killed process leaves the part written so far (see :mod:`cosim.log.writer`).
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import secrets
+from pathlib import Path
+from typing import Iterator, Sequence
+
+from cosim.errors import CosimError
+
+
+def check_new_file(path: Path, what: str, force: bool = False) -> None:
+    """Fail before any work when ``path`` cannot be created: it exists (without ``force``), is a
+    directory, or a file stands where a folder is needed. Missing folders are created later."""
+    if path.is_dir():
+        raise CosimError(f"{path}: is a directory, expected a file name for the {what}")
+    if path.exists() and not force:
+        raise CosimError(f"{path}: already exists; refusing to overwrite the {what} (use --force)")
+    blocking = next((folder for folder in reversed(path.parents) if folder.exists() and not folder.is_dir()), None)
+    if blocking is not None:
+        raise CosimError(f"{path}: cannot create the folder for the {what}: {str(blocking)!r} is a file")
+
+
+def unique_path(path: Path) -> Path:
+    """``path``, or ``<stem>-2<suffix>``, ``-3``, ... if it exists (for default names)."""
+    if not path.exists():
+        return path
+    for n in range(2, 10_000):
+        candidate = path.with_name(f"{path.stem}-{n}{path.suffix}")
+        if not candidate.exists():
+            return candidate
+    raise CosimError(f"{path}: too many runs with this name in the same second")
+
+
+def check_writable(path: str | os.PathLike[str], what: str, suffixes: Sequence[str] | None = None) -> None:
+    """Fail before the work when an output file in an existing folder cannot be written: ``path`` is a
+    directory, its folder does not exist, or its suffix is not one of ``suffixes`` (e.g. figure formats).
+    An existing file is overwritten (summaries and figures of ``cosim modes`` and a static ``cosim run``)."""
+    target = Path(path)
+    if target.is_dir():
+        raise CosimError(f"{path}: is a directory, expected a file name for the {what}")
+    parent = target.parent
+    if not parent.is_dir():
+        raise CosimError(f"{path}: cannot write the {what}: directory {str(parent)!r} does not exist")
+    if suffixes is not None and target.suffix.lower().lstrip(".") not in suffixes:
+        raise CosimError(
+            f"{path}: unsupported file type for the {what} (expected one of: "
+            + ", ".join("." + s for s in suffixes) + ")"
+        )
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike[str], what: str) -> Iterator[Path]:
+    """Write ``path`` through a temporary file: ``with atomic_write(out, "CSV") as tmp: <write tmp>``.
+
+    The temporary file sits in the same folder (created if missing) with the
+    same suffix (so writers that choose a format by suffix still work). When
+    the block ends normally the file is flushed to disk (fsync) and renamed
+    over ``path`` in one step; when it raises (or is interrupted) the
+    temporary file is removed and ``path`` is left as it was.
+
+    Raises:
+        CosimError: the folder, the temporary file or the rename fails (``what`` names the output).
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise CosimError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+    partial = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.part{path.suffix}")
+    try:
+        yield partial
+        try:
+            fd = os.open(partial, os.O_RDONLY)
+        except FileNotFoundError:
+            raise CosimError(f"{path}: cannot write the {what} (nothing was written)") from None
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(partial, path)
+    except OSError as exc:
+        raise CosimError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+    finally:
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)

@@ -1,0 +1,361 @@
+"""The tables of a scenario file besides ``[bridge]``: what loads the bridge, how it is solved, where results go.
+
+``[[sensors]]``, ``[[vehicles]]``, ``[traffic]``, ``[road]``, ``[solver]`` and
+``[output]``. Each table checks its own keys and lowers itself to the
+:mod:`cosim.core` object it describes (``to_model()``, ``to_scripted()``,
+``to_settings()``, ...). ``[bridge]``: :mod:`cosim.run.bridge_tables`; checks
+across tables: :class:`cosim.run.scenario.Scenario`. ``docs/scenario.md``
+documents every key.
+"""
+from __future__ import annotations
+
+import math
+import re
+from typing import Annotated, Any
+
+from pydantic import Field, PlainValidator, Strict, model_validator
+
+from cosim.core.roughness import ISO_CLASSES
+from cosim.core.simulation import SolverSettings
+from cosim.core.traffic import ScriptedVehicle
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.errors import ConfigError
+
+from .config_base import (
+    ConfigModel,
+    NetPoint,
+    NonNegative,
+    Number,
+    Positive,
+    PositiveInt,
+    Problems,
+    choice,
+    describe,
+    fail,
+    number_problem,
+    show,
+)
+
+__all__ = [
+    "BASES",
+    "DEFAULT_HHT_ALPHA",
+    "DEFAULT_MODAL_MODES",
+    "DEFAULT_RATE_HZ",
+    "DIRECTIONS",
+    "OutputConfig",
+    "QUANTITIES",
+    "ROAD_CLASSES",
+    "RoadConfig",
+    "SCHEMES",
+    "SUMO_LEVELS",
+    "SensorConfig",
+    "SolverConfig",
+    "TrafficConfig",
+    "VEHICLE_MODELS",
+    "VEHICLE_PARAMETERS",
+    "VehicleConfig",
+]
+
+# --------------------------------------------------------------------------- names
+
+#: Sensor quantities.
+QUANTITIES: tuple[str, ...] = ("displacement", "velocity", "acceleration", "bending_moment")
+
+SCHEMES: tuple[str, ...] = ("newmark", "hht")
+BASES: tuple[str, ...] = ("direct", "modal")
+
+#: Vehicle models of ``[[vehicles]]`` and their parameters: name -> (required, optional with default).
+VEHICLE_MODELS: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
+    "moving-force": (("mass",), {}),
+    "quarter-car": (("m_v", "m_w", "k_v", "c_v"), {}),
+    "tyre-quarter-car": (("m_v", "m_w", "k_v", "c_v", "k_t"), {"c_t": 0.0}),
+    "golden-car": (("m_v",), {}),
+}
+VEHICLE_PARAMETERS: tuple[str, ...] = ("mass", "m_v", "m_w", "k_v", "c_v", "k_t", "c_t")
+DIRECTIONS: dict[str, int] = {"+x": 1, "-x": -1}
+
+#: ``[road].class``: an ISO 8608 class, or a smooth road.
+ROAD_CLASSES: tuple[str, ...] = (*ISO_CLASSES, "smooth")
+
+#: ``[traffic].sumo_config`` may name one of these bundled demand levels (sumo_networks/<level>.sumocfg).
+SUMO_LEVELS: tuple[str, ...] = ("light", "medium", "heavy", "congested")
+
+_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
+
+DEFAULT_HHT_ALPHA = -0.05
+DEFAULT_MODAL_MODES = 30
+#: Default logging rate of ``[output]``, Hz (every step when dt is longer than its period).
+DEFAULT_RATE_HZ = 100.0
+
+
+# --------------------------------------------------------------------------- tables
+
+
+class SensorConfig(ConfigModel):
+    """``[[sensors]]``: a measured quantity at a deck point."""
+
+    name: Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
+    x: Number
+    y: Number = 0.0
+    quantity: Annotated[str, choice(QUANTITIES, "quantity")] = "displacement"
+
+
+def _speed_profile(value: Any) -> tuple[tuple[float, float], ...]:
+    """``profile = [[t, v], ...]``: t from entry (s), starting at 0 and increasing; v >= 0 (m/s)."""
+    if not isinstance(value, (list, tuple)) or not value:
+        raise fail(f"expected a non-empty array of [t, v] pairs (s, m/s), got {describe(value)}")
+    problems: list[tuple[tuple[int, ...], str]] = []
+    points: list[tuple[float, float]] = []
+    for i, item in enumerate(value):
+        if not isinstance(item, (list, tuple)) or len(item) != 2:
+            problems.append(((i,), f"expected a pair [t, v] (s, m/s), got {describe(item)}"))
+            continue
+        bad = [((i, j), msg) for j, v in enumerate(item) if (msg := number_problem(v))]
+        if bad:
+            problems.extend(bad)
+            continue
+        t, v = float(item[0]), float(item[1])
+        if i == 0 and t != 0.0:
+            problems.append(((0, 0), f"the first time must be 0 (time from the vehicle's entry; got {show(item[0])})"))
+        elif points and t <= points[-1][0]:
+            problems.append(
+                ((i, 0), f"times must increase (got {show(item[0])} after {show(points[-1][0])})")
+            )
+        if v < 0:
+            problems.append(((i, 1), f"speed must be >= 0 m/s (got {show(item[1])})"))
+        points.append((t, v))
+    if problems:
+        raise Problems(problems)
+    return tuple(points)
+
+
+SpeedProfile = Annotated[tuple[tuple[float, float], ...], PlainValidator(_speed_profile)]
+
+_CORE_KEY = re.compile(r"`(?P<key>\w+)`\s*(?P<rest>.*)", re.S)
+
+
+def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> Problems:
+    """A core-class message ("quarter-car: `m_v` must be ...") as a problem at that key."""
+    match = _CORE_KEY.search(str(exc))
+    if match and match["key"] in keys:
+        return fail(match["rest"].strip(), match["key"])
+    return fail(str(exc))
+
+
+class VehicleConfig(ConfigModel):
+    """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
+
+    id: Annotated[str, Strict(), Field(pattern=_NAME_PATTERN)]
+    model: Annotated[str, choice(tuple(VEHICLE_MODELS), "vehicle model")]
+    mass: Number | None = None
+    m_v: Number | None = None
+    m_w: Number | None = None
+    k_v: Number | None = None
+    c_v: Number | None = None
+    k_t: Number | None = None
+    c_t: Number | None = None
+    y: Number
+    speed: Positive | None = None
+    entry_time: NonNegative = 0.0
+    direction: Annotated[str, choice(tuple(DIRECTIONS), "direction")] = "+x"
+    profile: SpeedProfile | None = None
+
+    @model_validator(mode="after")
+    def _parameters(self) -> VehicleConfig:
+        required, optional = VEHICLE_MODELS[self.model]
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        listed = ", ".join((*required, *optional))
+        for key in VEHICLE_PARAMETERS:
+            if getattr(self, key) is not None and key not in required and key not in optional:
+                problems.append(((key,), f"not a parameter of model {show(self.model)} (its parameters: {listed})"))
+        for key in required:
+            if getattr(self, key) is None:
+                problems.append(((key,), f"required key is missing (model {show(self.model)} needs {listed})"))
+        if self.speed is not None and self.profile is not None:
+            problems.append((("speed",), "give either speed or profile, not both"))
+        if self.speed is None and self.profile is None:
+            problems.append((("speed",), "required key is missing (give speed, m/s, or a speed profile)"))
+        if problems:
+            raise Problems(problems)
+        try:
+            self.to_model()
+        except ConfigError as exc:
+            raise _rekeyed(exc, VEHICLE_PARAMETERS) from None
+        return self
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The model's parameters, defaults filled in (SI units)."""
+        required, optional = VEHICLE_MODELS[self.model]
+        values = {key: getattr(self, key) for key in required}
+        values.update({key: getattr(self, key) if getattr(self, key) is not None else default
+                       for key, default in optional.items()})
+        return values
+
+    def to_model(self) -> VehicleModel:
+        """The :mod:`cosim.core.vehicles` model this table describes.
+
+        Raises:
+            ConfigError: a non-physical parameter (the vehicle classes check them).
+        """
+        p = self.parameters
+        if self.model == "moving-force":
+            return MovingForce(mass=p["mass"])
+        if self.model == "quarter-car":
+            return QuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"])
+        if self.model == "tyre-quarter-car":
+            return TyreQuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"], k_t=p["k_t"], c_t=p["c_t"])
+        return TyreQuarterCar.golden_car(p["m_v"])
+
+    def to_scripted(self) -> ScriptedVehicle:
+        """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes."""
+        return ScriptedVehicle(
+            id=self.id,
+            model=self.to_model(),
+            y=self.y,
+            speed=self.speed if self.speed is not None else 0.0,
+            entry_time=self.entry_time,
+            direction=DIRECTIONS[self.direction],
+            profile=self.profile or (),
+        )
+
+
+class RoadConfig(ConfigModel):
+    """``[road]``: an ISO 8608 class with a seed, a profile file, or a smooth road."""
+
+    road_class: Annotated[str, choice(ROAD_CLASSES, "road class")] | None = Field(default=None, alias="class")
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
+    profile: Annotated[str, Strict(), Field(min_length=1)] | None = None
+
+    @model_validator(mode="after")
+    def _one_form(self) -> RoadConfig:
+        if self.road_class is not None and self.profile is not None:
+            raise fail(f"give either class or profile, not both (got class = {show(self.road_class)} "
+                        f"and profile = {show(self.profile)})")
+        if self.random and self.seed is None:
+            raise fail(
+                f"required key is missing: a random road (class = {show(self.road_class)}) needs a seed "
+                "(an integer >= 0) so that it can be reproduced, e.g. seed = 1", "seed"
+            )
+        if self.seed is not None and not self.random:
+            where = f"profile = {show(self.profile)}" if self.profile is not None else (
+                f"class = {show(self.road_class)}" if self.road_class is not None else "no class")
+            raise fail(f'only used with a random road, class = "A" ... "H" (got {where})', "seed")
+        return self
+
+    @property
+    def random(self) -> bool:
+        """True for an ISO 8608 class (A-H)."""
+        return self.road_class is not None and self.road_class in ISO_CLASSES
+
+    @property
+    def smooth(self) -> bool:
+        """True for a smooth road (``class = "smooth"`` or nothing given)."""
+        return not self.random and self.profile is None
+
+
+class TrafficConfig(ConfigModel):
+    """``[traffic]``: vehicles from a SUMO simulation (instead of scripted ``[[vehicles]]``)."""
+
+    sumo_config: Annotated[str, Strict(), Field(min_length=1)]
+    step: Positive = 0.05
+    begin: NonNegative = 0.0
+    end: Positive = 600.0
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
+    axis: tuple[NetPoint, NetPoint] | None = None
+    edges: tuple[Annotated[str, Strict(), Field(min_length=1)], ...] = ()
+
+    @model_validator(mode="after")
+    def _times(self) -> TrafficConfig:
+        if self.end <= self.begin:
+            raise fail(f"must be after begin = {show(self.begin)} s (got {show(self.end)})", "end")
+        if self.axis is not None and math.dist(*self.axis) <= 0:
+            raise fail("the two axis points must differ", "axis")
+        return self
+
+    @property
+    def bundled(self) -> bool:
+        return self.sumo_config in SUMO_LEVELS
+
+
+class SolverConfig(ConfigModel):
+    """``[solver]``: time integration settings."""
+
+    dt: Positive = 0.005
+    scheme: Annotated[str, choice(SCHEMES, "scheme")] = "newmark"
+    hht_alpha: Annotated[float, Strict(), Field(ge=-1.0 / 3.0, le=0.0)] | None = None
+    basis: Annotated[str, choice(BASES, "basis")] = "direct"
+    modes: PositiveInt | None = None
+    cutoff_hz: Positive | None = None
+    duration: Positive | None = None
+    gravity: NonNegative = 9.81
+
+    @model_validator(mode="before")
+    @classmethod
+    def _scheme_defaults(cls, data: Any) -> Any:
+        if isinstance(data, dict):
+            data = dict(data)
+            if data.get("scheme") == "hht":
+                data.setdefault("hht_alpha", DEFAULT_HHT_ALPHA)
+            if data.get("basis") == "modal" and "cutoff_hz" not in data:
+                data.setdefault("modes", DEFAULT_MODAL_MODES)
+        return data
+
+    @model_validator(mode="after")
+    def _relevant(self) -> SolverConfig:
+        problems = []
+        if self.hht_alpha is not None and self.scheme != "hht":
+            problems.append((("hht_alpha",), f'only used with scheme = "hht" (got scheme = "{self.scheme}")'))
+        for key in ("modes", "cutoff_hz"):
+            if getattr(self, key) is not None and self.basis != "modal":
+                problems.append(((key,), f'only used with basis = "modal" (got basis = "{self.basis}")'))
+        if self.basis == "modal" and self.modes is not None and self.cutoff_hz is not None:
+            problems.append((("cutoff_hz",), "give either modes or cutoff_hz for the modal basis, not both"))
+        if self.duration is not None and self.duration < self.dt:
+            problems.append((("duration",), f"must be >= dt = {show(self.dt)} s (got {show(self.duration)})"))
+        if problems:
+            raise Problems(problems)
+        return self
+
+    def to_settings(self) -> SolverSettings:
+        """The :class:`cosim.core.simulation.SolverSettings` this table describes."""
+        return SolverSettings(
+            dt=self.dt,
+            scheme=self.scheme,
+            hht_alpha=self.hht_alpha if self.hht_alpha is not None else DEFAULT_HHT_ALPHA,
+            basis=self.basis,
+            modes=self.modes,
+            cutoff_hz=self.cutoff_hz,
+            gravity=self.gravity,
+        )
+
+
+class OutputConfig(ConfigModel):
+    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, and the logging rate.
+
+    The rate is ``rate_hz`` (default :data:`DEFAULT_RATE_HZ`) or, for
+    compatibility, ``every`` (keep every N-th step); not both.
+    """
+
+    log: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    rate_hz: Positive | None = None
+    every: PositiveInt | None = None
+    csv: Annotated[str, Strict(), Field(min_length=1)] | None = None
+
+    @model_validator(mode="after")
+    def _one_rate(self) -> OutputConfig:
+        if self.rate_hz is not None and self.every is not None:
+            raise fail(
+                f"give either rate_hz (logging rate, Hz) or every (keep every N-th step), not both "
+                f"(got rate_hz = {show(self.rate_hz)} and every = {self.every})", "every"
+            )
+        if self.log is not None and not self.log.lower().endswith(".mcap"):
+            raise fail(f"the log is an MCAP file: expected a path ending in .mcap (got {show(self.log)})", "log")
+        return self
+
+    def decimation(self, dt: float) -> int:
+        """Steps per logged sample: ``every``, else ``round(1 / (rate_hz dt))`` (at least 1)."""
+        if self.every is not None:
+            return self.every
+        rate = self.rate_hz if self.rate_hz is not None else DEFAULT_RATE_HZ
+        return max(1, int(round(1.0 / (rate * dt))))
