@@ -45,7 +45,6 @@ import re
 import sys
 import time
 import traceback
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Annotated, Any, Callable, Sequence
@@ -65,13 +64,29 @@ from cosim.log.writer import (
 )
 
 ISO_CLASSES = tuple(_ISO)
-from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
+from cosim.run.config_base import (
+    ConfigModel,
+    Problems,
+    choices_message,
+    config_error,
+    fail,
+    show,
+)
 from cosim.run.scenario import (
     ROAD_CLASSES,
     SUMO_LEVELS,
     Scenario,
     list_bundled_scenarios,
     load_scenario,
+)
+from cosim.sumo.adapter import bundled_networks
+from cosim.sumo.files import (
+    SumoSet,
+    number_text,
+    read_sumo_set,
+    set_speed_limit,
+    set_truck_share,
+    set_vehicles_per_hour,
 )
 
 if sys.version_info >= (3, 11):
@@ -106,8 +121,6 @@ AXES: dict[str, str] = {
 }
 #: Axes that edit the SUMO demand: the base scenario needs [traffic] (or the sumo_config axis).
 SUMO_AXES = ("sumo_config", "vehicles_per_hour", "truck_share", "speed_limit")
-#: SUMO vehicle classes counted as trucks by ``truck_share``.
-HEAVY_VCLASSES = ("bus", "coach", "truck", "trailer")
 #: Bundled demand levels (``sumo_networks/<level>.sumocfg``): the scenario's own list.
 BUNDLED_LEVELS = SUMO_LEVELS
 DEFAULT_PERCENTILES = (50.0, 95.0, 99.0)
@@ -205,221 +218,8 @@ class StudyFile(ConfigModel):
 # --------------------------------------------------------------------------- SUMO inputs
 
 
-@dataclass(frozen=True)
-class SumoSet:
-    """A SUMO configuration and the files it names, flattened into one folder.
-
-    Attributes:
-        config: file name of the ``.sumocfg`` (a key of ``files``).
-        files: file name -> content; the config's ``net-file``, ``route-files``
-            and ``additional-files`` are rewritten to these names.
-        net: the network's file name; routes: route files; additional: additional files.
-        label: how runs name it (a bundled level, or the config's file stem).
-    """
-
-    config: str
-    files: dict[str, bytes]
-    net: str
-    routes: tuple[str, ...]
-    additional: tuple[str, ...]
-    label: str
-
-
-_FILE_OPTIONS = ("net-file", "route-files", "additional-files")
-
-
-def _parse_xml(data: bytes, name: str) -> ET.Element:
-    parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
-    try:
-        parser.feed(data)
-        return parser.close()
-    except ET.ParseError as exc:
-        raise ConfigError(f"{name}: not well-formed XML ({exc})") from None
-
-
-def _xml_bytes(root: ET.Element, note: str) -> bytes:
-    body = ET.tostring(root, encoding="unicode")
-    return f'<?xml version="1.0" encoding="UTF-8"?>\n<!-- {note} -->\n{body}\n'.encode()
-
-
-def bundled_config(level: str) -> Path:
-    """``sumo_networks/<level>.sumocfg`` of a bundled demand level."""
-    from cosim.sumo.adapter import bundled_networks
-
-    return bundled_networks() / f"{level}.sumocfg"
-
-
-def read_sumo_set(config: Path, label: str) -> SumoSet:
-    """Read a ``.sumocfg`` and the network, route and additional files it names.
-
-    Raises:
-        ConfigError: the config or a file it names is missing or not XML, or two
-            named files have the same file name.
-    """
-    try:
-        raw = config.read_bytes()
-    except OSError as exc:
-        raise ConfigError(f"{config}: cannot read the SUMO config ({exc.strerror})") from None
-    root = _parse_xml(raw, str(config))
-    files: dict[str, bytes] = {}
-    named: dict[str, list[str]] = {}
-    for option in _FILE_OPTIONS:
-        names: list[str] = []
-        for element in root.iter(option):
-            value = element.get("value", "")
-            rewritten = []
-            for item in (p for p in re.split(r"[,\s]+", value) if p):
-                path = Path(item) if Path(item).is_absolute() else config.parent / item
-                name = path.name
-                try:
-                    content = path.read_bytes()
-                except OSError as exc:
-                    raise ConfigError(f"{config}: {option}: cannot read {path} ({exc.strerror})") from None
-                if name in files and files[name] != content:
-                    raise ConfigError(f"{config}: {option}: two different files are named {name!r}; rename one")
-                files[name] = content
-                rewritten.append(name)
-                names.append(name)
-            element.set("value", ",".join(rewritten))
-        named[option] = names
-    if len(named["net-file"]) != 1:
-        raise ConfigError(f"{config}: expected one net-file, got {len(named['net-file'])}")
-    name = config.name if config.name.endswith(".sumocfg") else config.stem + ".sumocfg"
-    files[name] = _xml_bytes(root, f"{config.name}, its files flattened into this folder by cosim study")
-    return SumoSet(config=name, files=files, net=named["net-file"][0], routes=tuple(named["route-files"]),
-                   additional=tuple(named["additional-files"]), label=label)
-
-
-def _demand_files(sumo: SumoSet) -> list[str]:
-    return list(dict.fromkeys([*sumo.routes, *sumo.additional]))
-
-
-def set_vehicles_per_hour(sumo: SumoSet, rate: float) -> SumoSet:
-    """Every ``<flow>`` of the route and additional files gets ``vehsPerHour = rate`` (other rate keys removed).
-
-    Raises:
-        ConfigError: no ``<flow>`` in the demand files.
-    """
-    files = dict(sumo.files)
-    count = 0
-    for name in _demand_files(sumo):
-        root = _parse_xml(files[name], name)
-        flows = list(root.iter("flow"))
-        if not flows:
-            continue
-        for flow in flows:
-            for key in ("period", "probability", "number", "perHour"):
-                flow.attrib.pop(key, None)
-            flow.set("vehsPerHour", _number_text(rate))
-        count += len(flows)
-        files[name] = _xml_bytes(root, f"{name}: every flow at vehsPerHour = {_number_text(rate)} (cosim study)")
-    if not count:
-        raise ConfigError(f"{sumo.config}: vehicles_per_hour: no <flow> in its route or additional files "
-                          f"({', '.join(_demand_files(sumo)) or 'none'}); the rate sets flows only")
-    return _replace(sumo, files)
-
-
-def set_truck_share(sumo: SumoSet, share: float) -> SumoSet:
-    """Rescale every ``vTypeDistribution``: heavy vTypes (vClass bus, coach, truck, trailer) to ``share``.
-
-    Within each group the given probabilities keep their ratios. Both forms of
-    distribution are handled: nested ``<vType probability=...>`` elements and
-    ``vTypes="a b"`` with ``probabilities="..."``.
-
-    Raises:
-        ConfigError: no distribution, or a share that needs a group the distribution lacks.
-    """
-    files = dict(sumo.files)
-    roots = {name: _parse_xml(files[name], name) for name in _demand_files(sumo)}
-    vclass: dict[str, str] = {}
-    for root in roots.values():
-        for vtype in root.iter("vType"):
-            if vtype.get("id"):
-                vclass[vtype.get("id", "")] = vtype.get("vClass", "passenger")
-    changed: set[str] = set()
-    found = 0
-    for name, root in roots.items():
-        for dist in root.iter("vTypeDistribution"):
-            found += 1
-            did = dist.get("id", "?")
-            nested = [v for v in dist if v.tag == "vType"]
-            if nested:
-                ids = [v.get("id", "") for v in nested]
-                probs = [float(v.get("probability", "1")) for v in nested]
-            else:
-                ids = (dist.get("vTypes") or "").split()
-                text = (dist.get("probabilities") or "").split()
-                probs = [float(p) for p in text] if text else [1.0] * len(ids)
-                if len(probs) != len(ids):
-                    raise ConfigError(f"{name}: vTypeDistribution {did}: vTypes and probabilities differ in length")
-            heavy = [vclass.get(i, "passenger") in HEAVY_VCLASSES for i in ids]
-            new = _rescale(probs, heavy, share, f"{name}: vTypeDistribution {did}")
-            if nested:
-                for v, p in zip(nested, new):
-                    v.set("probability", _number_text(p))
-            else:
-                dist.set("probabilities", " ".join(_number_text(p) for p in new))
-            changed.add(name)
-    if not found:
-        raise ConfigError(f"{sumo.config}: truck_share: no vTypeDistribution in its route or additional files "
-                          "(the share rescales a distribution's probabilities)")
-    for name in changed:
-        files[name] = _xml_bytes(roots[name], f"{name}: truck share {_number_text(share)} (cosim study)")
-    return _replace(sumo, files)
-
-
-def _rescale(probs: list[float], heavy: list[bool], share: float, where: str) -> list[float]:
-    p = np.asarray(probs, dtype=float)
-    h = np.asarray(heavy, dtype=bool)
-    total_h, total_l = p[h].sum(), p[~h].sum()
-    if share > 0 and total_h <= 0:
-        raise ConfigError(f"{where}: truck_share = {_number_text(share)} but it has no truck vType "
-                          f"(vClass {', '.join(HEAVY_VCLASSES)}) with a probability > 0")
-    if share < 1 and total_l <= 0:
-        raise ConfigError(f"{where}: truck_share = {_number_text(share)} but it has only truck vTypes")
-    out = np.where(h, share * p / (total_h if total_h > 0 else 1.0),
-                   (1.0 - share) * p / (total_l if total_l > 0 else 1.0))
-    return [float(v) for v in out]
-
-
-def set_speed_limit(sumo: SumoSet, speed: float) -> SumoSet:
-    """Every lane of every non-internal edge of the network gets ``speed`` (m/s).
-
-    Raises:
-        ConfigError: a compressed network, or no lanes.
-    """
-    if sumo.net.endswith(".gz"):
-        raise ConfigError(f"{sumo.net}: speed_limit edits the network; give it uncompressed (.net.xml)")
-    files = dict(sumo.files)
-    root = _parse_xml(files[sumo.net], sumo.net)
-    count = 0
-    for edge in root.iter("edge"):
-        if edge.get("function", "normal") != "normal":
-            continue
-        if edge.get("speed") is not None:
-            edge.set("speed", _number_text(speed))
-        for lane in edge.iter("lane"):
-            lane.set("speed", _number_text(speed))
-            count += 1
-    if not count:
-        raise ConfigError(f"{sumo.net}: speed_limit: the network has no lanes")
-    files[sumo.net] = _xml_bytes(root, f"{sumo.net}: every lane at speed {_number_text(speed)} m/s (cosim study)")
-    return _replace(sumo, files)
-
-
-def _replace(sumo: SumoSet, files: dict[str, bytes]) -> SumoSet:
-    return SumoSet(sumo.config, files, sumo.net, sumo.routes, sumo.additional, sumo.label)
-
 
 # --------------------------------------------------------------------------- runs
-
-
-def _number_text(value: float) -> str:
-    """500.0 -> "500", 0.1 -> "0.1": the shortest text that reads back as the same number."""
-    value = float(value)
-    if value.is_integer() and abs(value) < 1e15:
-        return str(int(value))
-    return repr(value)
 
 
 def _id_part(text: str) -> str:
@@ -500,7 +300,7 @@ class Study:
             elif isinstance(value, str):
                 text = value
             else:
-                text = _number_text(value)
+                text = number_text(value)
             parts.append(f"{AXES[name]}-{_id_part(text)}")
         return "_".join(parts)
 
@@ -694,7 +494,7 @@ def _bundled_scenarios_dir() -> Path:
 
 def _config_path(value: str, folder: Path, where: str) -> Path:
     if value in BUNDLED_LEVELS:
-        return bundled_config(value)
+        return bundled_networks() / f"{value}.sumocfg"
     path = Path(value) if Path(value).is_absolute() else folder / value
     if not path.is_file():
         raise ConfigError(f"{where}: file not found: {path} (a bundled level is one of "
@@ -758,7 +558,7 @@ def _sensor_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentile
         row[f"{name}.max"] = hi
         row[f"{name}.peak"] = peak
         for q in percentiles:
-            row[f"{name}.p{_number_text(q)}"] = float(np.percentile(values, q)) if len(values) else None
+            row[f"{name}.p{number_text(q)}"] = float(np.percentile(values, q)) if len(values) else None
         row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
         row[f"{name}.static_peak"] = qs.peak[name]
         row[f"{name}.daf"] = daf(peak, qs.peak[name])

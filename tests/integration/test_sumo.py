@@ -12,7 +12,7 @@ from cosim.core.simulation import Sensor, SolverSettings, simulate
 from cosim.core.vehicles import QuarterCar
 from cosim.errors import SumoError
 from cosim.run.scenario import load_scenario
-from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks, model_from_parameters
+from cosim.sumo import BridgeAxis, SumoTraffic, bundled_networks, model_from_parameters
 
 AXIS = BridgeAxis((0.0, 0.0), (40.0, 0.0))
 G = 9.81
