@@ -28,8 +28,8 @@ from cosim.errors import ConfigError
 from cosim.log.writer import file_is_complete
 from cosim.run.logged import compare_sensors, run_logged
 from cosim.run.scenario import load_scenario
-from cosim.study.study import load_study, parse_study, run_study, summary_text
-from cosim.sumo.adapter import bundled_networks
+from cosim.study import load_study, parse_study, run_study, summary_text
+from cosim.sumo import bundled_networks
 
 REPO = Path(cosim.__file__).resolve().parents[1]
 
@@ -226,7 +226,7 @@ def test_a_study_on_a_separately_started_scheduler(on_two_workers, tmp_path):
 
 RUN_STUDY = """\
 import sys
-from cosim.study.study import load_study, run_study
+from cosim.study import load_study, run_study
 if __name__ == "__main__":
     run_study(load_study(sys.argv[1], output=sys.argv[2]), workers=1, plots=False)
 """
