@@ -150,8 +150,6 @@ class StudyFile(ConfigModel):
     sweep: SweepSection = SweepSection()
 
 
-
-
 # --------------------------------------------------------------------------- runs
 
 
@@ -239,6 +237,7 @@ class Study:
         return "_".join(parts)
 
     def sumo_label(self, value: str) -> str:
+        """How run ids and plots name a ``sumo_config`` value: its level or file stem (plus a hash if ambiguous)."""
         stem = value if value in BUNDLED_LEVELS else Path(value).name.removesuffix(".sumocfg")
         values = self.axes.get("sumo_config", ())
         stems = [v if v in BUNDLED_LEVELS else Path(v).name.removesuffix(".sumocfg") for v in values]

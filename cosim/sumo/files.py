@@ -14,8 +14,9 @@ The rules, the same for every caller:
 - a relative name is relative to the config's folder;
 - a file whose content starts with the gzip magic (``routes.rou.xml.gz``) is
   decompressed transparently, and an edited one is written back compressed;
-- reads are bounded (:data:`MAX_CONFIG_BYTES`, :data:`MAX_XML_BYTES`), and a
-  problem is a :class:`~cosim.errors.ConfigError` of one line naming the file.
+- a config is read up to :data:`MAX_CONFIG_BYTES` and a gzipped file
+  decompressed up to :data:`MAX_XML_BYTES` (a gzip bomb stops there);
+- a problem is a :class:`~cosim.errors.ConfigError` of one line naming the file.
 """
 from __future__ import annotations
 

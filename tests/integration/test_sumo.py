@@ -27,6 +27,7 @@ from cosim.sumo import (
     split_file_list,
     sumo_input_files,
 )
+from cosim.sumo import files as sumo_files
 from cosim.sumo.files import MAX_CONFIG_BYTES
 
 AXIS = BridgeAxis((0.0, 0.0), (40.0, 0.0))
@@ -204,7 +205,7 @@ def test_every_caller_splits_a_file_list_as_sumo_does(tmp_path):
     assert "other_car" in traffic.models and not {"mix", "other"} & set(traffic.models)
 
 
-def test_gzipped_files_are_read_like_plain_ones(tmp_path):
+def test_gzipped_files_are_read_like_plain_ones(tmp_path, monkeypatch):
     """Distribution ids are found in gzipped files, so SUMO runs on them with every vType a vehicle model."""
     gz = {f"{name}.gz": gzip.compress((bundled_networks() / name).read_bytes())
           for name in ("bridge.net.xml", "vtypes.add.xml", "medium.rou.xml")}
@@ -221,6 +222,10 @@ def test_gzipped_files_are_read_like_plain_ones(tmp_path):
     cut.write_bytes(gz["medium.rou.xml.gz"][:40])
     with pytest.raises(ConfigError, match=r"^.*cut\.rou\.xml\.gz: not a readable gzip file \(it ends early\)$"):
         read_input(cut)
+    # Decompression stops at the bound (a gzip bomb), here lowered to 1 kB.
+    monkeypatch.setattr(sumo_files, "MAX_XML_BYTES", 1000)
+    with pytest.raises(ConfigError, match=r"vtypes\.add\.xml\.gz: more than 1000 bytes once decompressed; not read$"):
+        read_input(tmp_path / "vtypes.add.xml.gz")
 
 
 def test_sumo_config_errors_are_one_line_naming_the_file(tmp_path):
