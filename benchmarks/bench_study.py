@@ -76,7 +76,7 @@ def machine_parallelism(workers: int, n: int = 10_000_000) -> float:
 
 
 def main() -> int:
-    from cosim.study.study import default_workers, parse_study, run_study
+    from cosim.study import default_workers, parse_study, run_study
 
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="4 runs of 120 s instead of 8 of 300 s")

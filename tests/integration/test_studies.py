@@ -2,13 +2,14 @@
 
 A small study (2 volumes x 2 seeds of 60 s on a coarse 40 m girder) runs on a
 local cluster of 2 worker processes; its rows are checked against the same
-scenarios run one by one in this process, against a 1-worker cluster, and
-against a scheduler and workers started as separate processes. Then: a study
-interrupted with Ctrl-C resumes, and a run with a broken SUMO file is
-reported while the others finish.
+runs one after another in this process and against a scheduler and workers
+started as separate processes. Then: a study interrupted with Ctrl-C (on a
+local cluster of 1 worker) resumes, a run with a broken SUMO file is reported
+while the others finish, and gzipped SUMO files sweep like plain ones.
 """
 from __future__ import annotations
 
+import gzip
 import json
 import os
 import shutil
@@ -28,8 +29,8 @@ from cosim.errors import ConfigError
 from cosim.log.writer import file_is_complete
 from cosim.run.logged import compare_sensors, run_logged
 from cosim.run.scenario import load_scenario
-from cosim.study.study import load_study, parse_study, run_study, summary_text
-from cosim.sumo.adapter import bundled_networks
+from cosim.study import load_study, parse_study, run_study, summary_text
+from cosim.sumo import bundled_networks
 
 REPO = Path(cosim.__file__).resolve().parents[1]
 
@@ -79,6 +80,9 @@ dt = 0.025
 rate_hz = 40.0
 """
 
+#: The same with its first sensor only: fewer plots, where a test is not about them.
+BASE_ONE_SENSOR = BASE[:BASE.index('[[sensors]]\nname = "mid_moment"')] + BASE[BASE.index("[traffic]"):]
+
 STUDY = """\
 [study]
 name = "small"
@@ -106,18 +110,19 @@ def _numbers(frame: pd.DataFrame) -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def on_two_workers(tmp_path_factory):
-    """The small study on a local cluster of 2 worker processes."""
+def small_study(tmp_path_factory):
+    """The small study, one run after another in this process: the reference the other executions must match."""
     folder = tmp_path_factory.mktemp("study")
     study = load_study(_write_study(folder), output=folder / "out")
     seen = []
-    outcome = run_study(study, workers=2, progress=lambda done, total, row: seen.append((done, total)))
+    outcome = run_study(study, workers=0, progress=lambda done, total, row: seen.append((done, total)))
     return study, outcome, seen
 
 
-def test_two_volumes_two_seeds_on_two_workers_give_four_rows(on_two_workers):
-    study, outcome, seen = on_two_workers
-    assert outcome.workers == 2
+def test_two_volumes_two_seeds_give_four_rows_a_table_and_plots(small_study):
+    study, outcome, seen = small_study
+    assert outcome.workers == 0
+    assert "Runs: 4: 4 run now in this process, 0 reused from earlier, 0 failed" in summary_text(outcome)
     assert [r["run_id"] for r in outcome.rows] == [
         "vph-300_seed-1", "vph-300_seed-2", "vph-900_seed-1", "vph-900_seed-2"]
     assert outcome.failed == [] and len(outcome.ran) == 4 and outcome.skipped == []
@@ -146,32 +151,31 @@ def test_two_volumes_two_seeds_on_two_workers_give_four_rows(on_two_workers):
     assert 'vehsPerHour="900"' in (run / "sumo" / "medium.rou.xml").read_text()
 
 
-def test_the_rows_are_the_runs_one_by_one(on_two_workers, tmp_path):
-    """Each generated scenario, run by itself in this process, gives the row's numbers exactly."""
-    study, outcome, _ = on_two_workers
-    for row in outcome.rows:
-        folder = study.output / "runs" / row["run_id"]
-        scenario = load_scenario(folder / "scenario.toml")
-        alone = run_logged(scenario, tmp_path / f"{row['run_id']}.mcap")
-        for name in ("mid", "mid_moment", "mid_acc"):
-            assert row[f"{name}.min"] == alone.result.sensor_min[name]
-            assert row[f"{name}.max"] == alone.result.sensor_max[name]
-        assert row["vehicles"] == len(alone.result.vehicle_ids)
-        assert row["max_on_deck"] == alone.result.max_on_deck
-        assert row["liftoff_events"] == alone.result.liftoff_events
-        assert compare_sensors(folder / "run.mcap", alone.log_path).identical
+def test_the_rows_are_the_runs_one_by_one(small_study, tmp_path):
+    """A run's scenario runs by itself (``cosim run runs/<id>/scenario.toml``) and gives its row's numbers exactly."""
+    study, outcome, _ = small_study
+    row = outcome.rows[-1]
+    folder = study.output / "runs" / row["run_id"]
+    alone = run_logged(load_scenario(folder / "scenario.toml"), tmp_path / "alone.mcap")
+    for name in ("mid", "mid_moment", "mid_acc"):
+        assert row[f"{name}.min"] == alone.result.sensor_min[name]
+        assert row[f"{name}.max"] == alone.result.sensor_max[name]
+    assert row["vehicles"] == len(alone.result.vehicle_ids)
+    assert row["max_on_deck"] == alone.result.max_on_deck
+    assert row["liftoff_events"] == alone.result.liftoff_events
+    assert compare_sensors(folder / "run.mcap", alone.log_path).identical
 
 
-def test_the_numbers_do_not_depend_on_the_number_of_workers(on_two_workers, tmp_path):
-    study, outcome, _ = on_two_workers
-    again = run_study(load_study(study.source, output=tmp_path / "one"), workers=1, plots=False)
-    assert again.workers == 1
-    pd.testing.assert_frame_equal(_numbers(again.table()).drop(columns="log"),
-                                  _numbers(outcome.table()).drop(columns="log"))
+def _same_runs(outcome, reference) -> None:
+    """Rows (wall times aside) and sensor logs identical, bit for bit, to the reference's."""
+    pd.testing.assert_frame_equal(_numbers(outcome.table()), _numbers(reference.table()))
+    for row in reference.rows:
+        ours, theirs = (o.study.output / "runs" / row["run_id"] for o in (outcome, reference))
+        assert compare_sensors(ours / "run.mcap", theirs / "run.mcap").identical, row["run_id"]
 
 
-def test_a_second_run_of_the_same_study_redoes_nothing(on_two_workers):
-    study, outcome, _ = on_two_workers
+def test_a_second_run_of_the_same_study_redoes_nothing(small_study):
+    study, outcome, _ = small_study
     logs = {r: (study.output / "runs" / r / "run.mcap").stat().st_mtime_ns for r in outcome.ran}
     again = run_study(load_study(study.source, output=study.output), workers=2, plots=False)
     assert again.ran == [] and again.skipped == outcome.ran and again.workers == 0
@@ -190,13 +194,13 @@ def _dask(*args: str, cwd: Path) -> subprocess.Popen:
                             start_new_session=True)
 
 
-def test_a_study_on_a_separately_started_scheduler(on_two_workers, tmp_path):
-    """``dask scheduler`` and ``dask worker`` processes started apart, in a folder of their own."""
+def test_a_study_on_a_separately_started_scheduler_gives_the_same_runs(small_study, tmp_path):
+    """``dask scheduler`` and ``dask worker --nworkers 2`` processes started apart, in a folder of their own."""
     from dask.distributed import Client
 
     if shutil.which("dask") is None:
         pytest.fail("the `dask` command (dask[distributed]) is not on PATH")
-    study, outcome, _ = on_two_workers
+    study, outcome, _ = small_study
     elsewhere = tmp_path / "elsewhere"  # the workers' working folder: not the caller's
     elsewhere.mkdir()
     address = f"tcp://127.0.0.1:{_free_port()}"
@@ -219,14 +223,14 @@ def test_a_study_on_a_separately_started_scheduler(on_two_workers, tmp_path):
                 except subprocess.TimeoutExpired:
                     os.killpg(proc.pid, signal.SIGKILL)
     assert remote.workers == 2 and remote.failed == []
-    pd.testing.assert_frame_equal(_numbers(remote.table()).drop(columns="log"),
-                                  _numbers(outcome.table()).drop(columns="log"))
+    assert "Runs: 4: 4 run now on 2 workers, 0 reused from earlier, 0 failed" in summary_text(remote)
+    _same_runs(remote, outcome)
     assert not any(elsewhere.glob("**/*.mcap"))  # every log went to the output folder
 
 
 RUN_STUDY = """\
 import sys
-from cosim.study.study import load_study, run_study
+from cosim.study import load_study, run_study
 if __name__ == "__main__":
     run_study(load_study(sys.argv[1], output=sys.argv[2]), workers=1, plots=False)
 """
@@ -243,10 +247,12 @@ def _ok_runs(out: Path) -> dict[str, int]:
     return found
 
 
-def test_an_interrupted_study_resumes_without_redoing_finished_runs(tmp_path):
-    """Ctrl-C after the first finished run; the same command again runs only the rest."""
-    study_path = _write_study(tmp_path, STUDY.replace(
-        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "seeds = [1, 2, 3, 4]"))
+def test_an_interrupted_study_resumes_without_redoing_finished_runs(small_study, tmp_path):
+    """On a local cluster of 1 worker, Ctrl-C after the first finished run; the same study again runs only the rest.
+
+    The finished runs, from the cluster, and the rest, from this process, make the same rows as the reference.
+    """
+    study_path = _write_study(tmp_path)
     out = tmp_path / "out"
     script = tmp_path / "go.py"
     script.write_text(RUN_STUDY)
@@ -272,10 +278,11 @@ def test_an_interrupted_study_resumes_without_redoing_finished_runs(tmp_path):
         del finished[cut]
     resumed = run_study(load_study(study_path, output=out), workers=0, plots=False)
     assert sorted(resumed.skipped) == sorted(finished)
-    assert sorted(resumed.ran) == sorted(set(f"seed-{s}" for s in (1, 2, 3, 4)) - set(finished))
+    assert sorted(resumed.ran) == sorted(set(small_study[1].ran) - set(finished))
     assert resumed.failed == []
     assert {k: v for k, v in _ok_runs(out).items() if k in finished} == finished  # logs not rewritten
     assert len(pd.read_csv(out / "results.csv")) == 4
+    _same_runs(resumed, small_study[1])
 
 
 def _broken_sumo(folder: Path) -> Path:
@@ -296,8 +303,8 @@ def test_a_failing_run_is_reported_and_the_others_finish(tmp_path):
     _broken_sumo(tmp_path / "mine")
     study_path = _write_study(tmp_path, STUDY.replace(
         "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]",
-        'sumo_config = ["light", "mine/broken.sumocfg"]\nseeds = [1]'))
-    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=2)
+        'sumo_config = ["light", "mine/broken.sumocfg"]\nseeds = [1]'), BASE_ONE_SENSOR)
+    outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=0)
     table = pd.read_csv(outcome.table_csv).set_index("run_id")
     assert list(table.index) == ["cfg-light_seed-1", "cfg-broken_seed-1"]
     assert outcome.failed == ["cfg-broken_seed-1"]
@@ -307,7 +314,7 @@ def test_a_failing_run_is_reported_and_the_others_finish(tmp_path):
     assert np.isnan(table.loc["cfg-broken_seed-1", "mid.peak"])
     assert (tmp_path / "out" / "plots" / "mid.peak.png").is_file()  # from the runs that worked
     summary = summary_text(outcome)
-    assert "Runs: 2: 2 run now on 2 workers, 0 reused from earlier, 1 failed" in summary
+    assert "Runs: 2: 2 run now in this process, 0 reused from earlier, 1 failed" in summary
     assert "  cfg-broken_seed-1: " in summary and "nowhere" in summary
     # Re-running retries the failed run only.
     again = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
@@ -342,15 +349,44 @@ def test_sweeping_the_speed_limit_slows_the_traffic(tmp_path):
     assert 7.0 < speeds[10.0] < 11.5 < 18.0 < speeds[25.0]
 
 
-def test_truck_share_changes_the_mix(tmp_path):
-    """All trucks vs no trucks: the heaviest vehicle on the deck tells which."""
+def _gzipped_medium(folder: Path) -> Path:
+    """The bundled medium demand with every file gzipped: network, vehicle types and routes."""
+    folder.mkdir(parents=True)
+    for name in ("bridge.net.xml", "vtypes.add.xml", "medium.rou.xml"):
+        (folder / f"{name}.gz").write_bytes(gzip.compress((bundled_networks() / name).read_bytes()))
+    cfg = folder / "medium-gz.sumocfg"
+    cfg.write_text('<configuration><input><net-file value="bridge.net.xml.gz"/>'
+                   '<route-files value="vtypes.add.xml.gz, medium.rou.xml.gz"/></input></configuration>')
+    return cfg
+
+
+def test_gzipped_sumo_files_sweep_like_plain_ones_and_truck_share_changes_the_mix(tmp_path):
+    """The bundled medium demand, plain and gzipped: every edit applies to both, and the runs are identical.
+
+    All trucks vs no trucks: the heaviest vehicle on the deck tells which.
+    """
+    _gzipped_medium(tmp_path / "gz")
     study_path = _write_study(tmp_path, STUDY.replace(
-        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "truck_share = [0.0, 1.0]\nvehicles_per_hour = [900.0]"))
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]",
+        'sumo_config = ["medium", "gz/medium-gz.sumocfg"]\ntruck_share = [0.0, 1.0]\nvehicles_per_hour = [900.0]\n'
+        "speed_limit = [16.0]"))
     outcome = run_study(load_study(study_path, output=tmp_path / "out"), workers=0, plots=False)
-    rows = {r["truck_share"]: r for r in outcome.rows}
-    assert rows[0.0]["heaviest_kg"] <= 3000.0  # cars (1.5 t) and vans (3 t) only
-    assert rows[1.0]["heaviest_kg"] >= 11000.0
-    assert rows[1.0]["mid.peak"] > rows[0.0]["mid.peak"]
+    assert outcome.failed == []
+    rows = {(r["sumo_config"], r["truck_share"]): r for r in outcome.rows}
+    for cfg in ("medium", "gz/medium-gz.sumocfg"):
+        assert rows[cfg, 0.0]["heaviest_kg"] <= 3000.0  # cars (1.5 t) and vans (3 t) only
+        assert rows[cfg, 1.0]["heaviest_kg"] >= 11000.0
+        assert rows[cfg, 1.0]["mid.peak"] > rows[cfg, 0.0]["mid.peak"]
+    table = _numbers(outcome.table()).drop(columns=["run_id", "sumo_config", "log"])
+    pd.testing.assert_frame_equal(table.iloc[2:].reset_index(drop=True), table.iloc[:2].reset_index(drop=True))
+    # The gzipped run's inputs stay gzipped, with the edits inside.
+    sumo = outcome.study.output / "runs" / "cfg-medium-gz_vph-900_trucks-1_vmax-16" / "sumo"
+    edited = {name: gzip.decompress((sumo / name).read_bytes()).decode()
+              for name in ("medium.rou.xml.gz", "vtypes.add.xml.gz", "bridge.net.xml.gz")}
+    assert 'vehsPerHour="900"' in edited["medium.rou.xml.gz"]
+    assert "truck share 1 (cosim study)" in edited["vtypes.add.xml.gz"]
+    assert 'speed="16"' in edited["bridge.net.xml.gz"]
+    assert "vtypes.add.xml.gz,medium.rou.xml.gz" in (sumo / "medium-gz.sumocfg").read_text()
 
 
 def test_study_file_errors_name_the_file_and_the_key(tmp_path):
@@ -397,7 +433,8 @@ def test_the_study_command(tmp_path):
 
     study_path = _write_study(tmp_path, STUDY.replace("vehicles_per_hour = [300.0, 900.0]",
                                                       "vehicles_per_hour = [300.0]").replace("seeds = [1, 2]",
-                                                                                             "seeds = [1]"))
+                                                                                             "seeds = [1]"),
+                              BASE_ONE_SENSOR)
     done = cosim_cli("study", str(study_path), "--workers", "0", "--quiet", "--out", "out", cwd=tmp_path)
     assert done.returncode == 0, done.stderr
     table = pd.read_csv(tmp_path / "out" / "results.csv")

@@ -1,7 +1,10 @@
 """SUMO co-simulation with real SUMO through libsumo (no mocks)."""
 from __future__ import annotations
 
+import gzip
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -11,9 +14,22 @@ from cosim.core.bridge import PointLoad
 from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.vehicles import QuarterCar
-from cosim.errors import SumoError
+from cosim.errors import ConfigError, SumoError
 from cosim.run.scenario import load_scenario
-from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks, model_from_parameters
+from cosim.sumo import (
+    BridgeAxis,
+    SumoTraffic,
+    bundled_networks,
+    distribution_ids,
+    model_from_parameters,
+    read_config,
+    read_input,
+    read_sumo_set,
+    split_file_list,
+    sumo_input_files,
+)
+from cosim.sumo import files as sumo_files
+from cosim.sumo.files import MAX_CONFIG_BYTES
 
 AXIS = BridgeAxis((0.0, 0.0), (40.0, 0.0))
 G = 9.81
@@ -141,6 +157,96 @@ def test_vtype_parameters_become_quarter_cars():
         model_from_parameters("bad", 1500.0, "passenger", {"cosim.m_w": "2000"})
 
 
+def test_importing_the_sumo_package_does_not_load_libsumo():
+    code = "import sys, cosim.sumo; print('libsumo' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+# ------------------------------------------------------------------ SUMO's files, read by one reader
+
+
+def _files(folder: Path, files: dict[str, bytes], routes: str) -> Path:
+    """The bundled network and ``files`` in ``folder``, and a config naming ``routes`` as its route files."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, content in files.items():
+        (folder / name).write_bytes(content)
+    net = "bridge.net.xml.gz" if "bridge.net.xml.gz" in files else "bridge.net.xml"
+    if net not in files:
+        shutil.copy(bundled_networks() / net, folder / net)
+    cfg = folder / "test.sumocfg"
+    cfg.write_text(f'<configuration><input><net-file value="{net}"/><route-files value="{routes}"/></input>'
+                   '</configuration>')
+    return cfg
+
+
+OTHER = (b'<routes><vTypeDistribution id="other"><vType id="other_car" vClass="passenger" mass="1500" '
+         b'probability="1"/></vTypeDistribution><flow id="f" type="other" begin="0" end="100" vehsPerHour="600" '
+         b'from="in_e" to="out_e"/></routes>')
+
+
+def test_every_caller_splits_a_file_list_as_sumo_does(tmp_path):
+    """``"a.xml, b.xml c.xml"``: commas separate, white space around a name goes; SUMO reads the same two files."""
+    mix = (bundled_networks() / "vtypes.add.xml").read_bytes()
+    cfg = _files(tmp_path, {"a.xml": mix, "b.xml c.xml": OTHER}, "a.xml, b.xml c.xml")
+    assert split_file_list("a.xml, b.xml c.xml") == ["a.xml", "b.xml c.xml"]
+    assert sumo_input_files(cfg) == [cfg, tmp_path / "bridge.net.xml", tmp_path / "a.xml", tmp_path / "b.xml c.xml"]
+    assert distribution_ids(cfg) == {"mix", "other"}
+    flat = read_sumo_set(cfg, "test")
+    assert flat.routes == ("a.xml", "b.xml c.xml") and flat.files["b.xml c.xml"] == OTHER
+    assert b'<route-files value="a.xml,b.xml c.xml" />' in flat.files["test.sumocfg"]
+    with SumoTraffic(cfg, AXIS, end=100.0, half_width=6.655) as traffic:
+        for _ in range(400):
+            traffic.advance()
+        import libsumo
+
+        assert {"mix", "other", "other_car"} <= set(libsumo.vehicletype.getIDList())
+        running = libsumo.vehicle.getIDList()  # the flow of "b.xml c.xml", drawing from its distribution
+        assert running and {libsumo.vehicle.getTypeID(v) for v in running} == {"other_car"}
+    assert "other_car" in traffic.models and not {"mix", "other"} & set(traffic.models)
+
+
+def test_gzipped_files_are_read_like_plain_ones(tmp_path, monkeypatch):
+    """Distribution ids are found in gzipped files, so SUMO runs on them with every vType a vehicle model."""
+    gz = {f"{name}.gz": gzip.compress((bundled_networks() / name).read_bytes())
+          for name in ("bridge.net.xml", "vtypes.add.xml", "medium.rou.xml")}
+    cfg = _files(tmp_path, gz, "vtypes.add.xml.gz,medium.rou.xml.gz")
+    assert [p.name for p in sumo_input_files(cfg)] == ["test.sumocfg", *gz]
+    assert distribution_ids(cfg) == {"mix"}
+    assert read_input(tmp_path / "medium.rou.xml.gz") == (bundled_networks() / "medium.rou.xml").read_bytes()
+    with SumoTraffic(cfg, AXIS, end=100.0, half_width=6.655) as traffic:
+        for _ in range(600):
+            traffic.advance()
+    assert "mix" not in traffic.models and {"car", "artic_loaded"} <= set(traffic.models)
+    # A cut gzip stream: one line, naming the file.
+    cut = tmp_path / "cut.rou.xml.gz"
+    cut.write_bytes(gz["medium.rou.xml.gz"][:40])
+    with pytest.raises(ConfigError, match=r"^.*cut\.rou\.xml\.gz: not a readable gzip file \(it ends early\)$"):
+        read_input(cut)
+    # Decompression stops at the bound (a gzip bomb), here lowered to 1 kB.
+    monkeypatch.setattr(sumo_files, "MAX_XML_BYTES", 1000)
+    with pytest.raises(ConfigError, match=r"vtypes\.add\.xml\.gz: more than 1000 bytes once decompressed; not read$"):
+        read_input(tmp_path / "vtypes.add.xml.gz")
+
+
+def test_sumo_config_errors_are_one_line_naming_the_file(tmp_path):
+    with pytest.raises(ConfigError, match=r"missing\.sumocfg: cannot read the SUMO config \(No such file"):
+        read_config(tmp_path / "missing.sumocfg")
+    bad = tmp_path / "bad.sumocfg"
+    bad.write_text("<configuration><input>")
+    with pytest.raises(ConfigError, match=r"bad\.sumocfg: not well-formed XML \(no element found: line 1"):
+        sumo_input_files(bad)
+    assert distribution_ids(bad) == set()  # lenient: SUMO itself judges a config it runs
+    huge = tmp_path / "huge.sumocfg"
+    huge.write_bytes(b"<configuration>" + b" " * MAX_CONFIG_BYTES + b"</configuration>")
+    with pytest.raises(ConfigError, match="huge.sumocfg: more than 1048576 bytes; not a SUMO config"):
+        read_config(huge)
+    for problem in ("missing", "bad", "huge"):
+        with pytest.raises(ConfigError) as info:
+            read_config(tmp_path / f"{problem}.sumocfg")
+        assert "\n" not in str(info.value)
+
+
 def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, tmp_path):
     from cosim.log.writer import TOPIC_SENSORS, BlockLogger, LogRecorder, TrafficLogger, read_log, traffic_from_log
 
@@ -163,9 +269,6 @@ def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, t
 
 
 # ------------------------------------------------------------------ command line
-import subprocess  # noqa: E402
-import sys  # noqa: E402
-
 from cosim.run.scenario import SUMO_LEVELS  # noqa: E402
 
 SCENARIO = """
@@ -222,11 +325,18 @@ def test_cli_runs_sumo_traffic_and_replays_it_bit_for_bit(tmp_path):
     replay = cosim("replay", "a.mcap", "--out", "b.mcap", "--quiet", cwd=tmp_path)
     assert replay.returncode == 0, replay.stderr
     assert "identical, bit for bit" in replay.stdout and "SUMO is not run again" in replay.stdout
-    other = cosim("replay", "a.mcap", "--scenario", "paper-double-tee-asymmetric", "--out", "c.mcap", "--quiet",
-                  cwd=tmp_path)
+    # The same traffic on another bridge: finer and stiffer than the logged one.
+    (tmp_path / "other.toml").write_text(SCENARIO.format(config="heavy", end=60.0).replace(
+        "elements_per_span = 10", "elements_per_span = 16").replace("I_y = 1.6", "I_y = 2.4"))
+    other = cosim("replay", "a.mcap", "--scenario", "other.toml", "--out", "c.mcap", "--quiet", cwd=tmp_path)
     assert other.returncode == 0, other.stderr
-    info = cosim("info", "a.mcap", cwd=tmp_path).stdout
-    assert "sumo/heavy.sumocfg" in info and "sumo/bridge.net.xml" in info  # the inputs travel with the log
+    assert "its SUMO traffic" in other.stdout and "Bridge: 40 m, 16 elements" in other.stdout
+    # The inputs travel with the log (``cosim info`` lists them; tested with the logging commands).
+    from cosim.log.writer import read_log
+
+    attached = read_log(tmp_path / "a.mcap").attachments
+    for name in ("heavy.sumocfg", "bridge.net.xml", "vtypes.add.xml", "heavy.rou.xml"):
+        assert attached[f"sumo/{name}"] == (bundled_networks() / name).read_bytes(), name
 
 
 def test_cli_reports_a_broken_sumo_config_and_finishes_the_log(tmp_path):

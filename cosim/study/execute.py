@@ -1,0 +1,335 @@
+"""Running a study: each run in a process of its own (a Dask worker), resuming, and the whole study.
+
+Runs are plain functions (:func:`execute_run`) of a :class:`~cosim.study.spec.RunTask`
+that carries every input as text, executed on a Dask cluster: a local one of
+worker processes by default (one libsumo simulation per process), or an
+existing scheduler. A run whose ``result.json`` matches its inputs and whose
+log is complete is not run again (:func:`finished_row`): re-running a study
+resumes it. A failing run is recorded in its row; the others go on. Nothing
+here prints.
+"""
+from __future__ import annotations
+
+import json
+import logging
+import os
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+from typing import Any, Callable
+
+from cosim.errors import ConfigError, CosimError
+from cosim.run.logged import run_logged
+from cosim.run.scenario import load_scenario
+from cosim.study.folder import LOG_FILE, PLOTS_FOLDER, RESULT_FILE, RUNS_FOLDER, SCENARIO_FILE, STUDY_FILE, write_file
+from cosim.study.logs import log_is_complete
+from cosim.study.spec import RunTask, Study, error_text
+from cosim.study.table import base_row, jsonable_row, plot_study, run_statistics, table_frame, write_table
+
+__all__ = [
+    "Progress",
+    "StudyOutcome",
+    "default_workers",
+    "execute_run",
+    "finished_row",
+    "run_study",
+    "summary_text",
+]
+
+#: How long to wait for a remote scheduler to have a worker, s.
+WORKER_WAIT = 60.0
+
+log = logging.getLogger(__name__)
+
+
+# --------------------------------------------------------------------------- one run (on a worker)
+
+
+def execute_run(task: RunTask) -> dict[str, Any]:
+    """Run one study run in this process and return its row of results (also stored as ``result.json``).
+
+    Writes the task's files and ``scenario.toml`` into ``task.folder``, runs the
+    scenario into ``run.mcap`` (replacing one left by an interrupted attempt),
+    then reduces the log to the row. Any failure is recorded in the row
+    (``status = "error"``, ``error`` = the message); it never raises, except for
+    Ctrl-C.
+    """
+    started = time.perf_counter()
+    folder = Path(task.folder)
+    row = base_row(task)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / RESULT_FILE).unlink(missing_ok=True)
+        if task.error is not None:
+            raise ConfigError(task.error)
+        for name, content in task.files.items():
+            pure = PurePosixPath(name)
+            if pure.is_absolute() or ".." in pure.parts:
+                raise ConfigError(f"unsafe file name in the run's inputs: {name!r}")
+            write_file(folder.joinpath(*pure.parts), content)
+        write_file(folder / SCENARIO_FILE, task.scenario_text)
+        scenario = load_scenario(folder / SCENARIO_FILE)
+        bridge = scenario.build_bridge()
+        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge)
+        row.update(run_statistics(scenario, bridge, outcome, task.percentiles))
+        row["status"] = "ok"
+        row["error"] = ""
+    except KeyboardInterrupt:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a failing run is recorded, the study goes on
+        row["status"] = "error"
+        row["error"] = error_text(exc)
+        if not isinstance(exc, CosimError):
+            log.debug("run %s failed:\n%s", task.run_id, traceback.format_exc())
+    row["wall_time_total"] = time.perf_counter() - started
+    row["log"] = f"{RUNS_FOLDER}/{task.run_id}/{LOG_FILE}"
+    row = jsonable_row(row)
+    try:
+        write_file(folder / RESULT_FILE, json.dumps({"fingerprint": task.fingerprint, "row": row}, indent=1))
+    except OSError as exc:
+        row["status"] = "error"
+        row["error"] = error_text(exc)
+    return row
+
+
+def finished_row(task: RunTask) -> dict[str, Any] | None:
+    """The stored row of a run that need not run again: status ok, same inputs, complete log; else None."""
+    folder = Path(task.folder)
+    try:
+        stored = json.loads((folder / RESULT_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(stored, dict) or stored.get("fingerprint") != task.fingerprint:
+        return None
+    row = stored.get("row")
+    if not isinstance(row, dict) or row.get("status") != "ok":
+        return None
+    if not log_is_complete(folder / LOG_FILE):
+        return None
+    return row
+
+
+# --------------------------------------------------------------------------- the whole study
+
+
+@dataclass
+class StudyOutcome:
+    """What :func:`run_study` did.
+
+    Attributes:
+        study: the study.
+        rows: one row per run, in sweep order.
+        ran: run ids executed now; skipped: run ids whose stored results were reused.
+        failed: run ids whose status is "error".
+        table_csv, table_parquet: the results table.
+        plots: the PNG files written.
+        wall_time: s, the whole study (cluster start-up included).
+        workers: how many workers ran the runs (0: in this process).
+    """
+
+    study: Study
+    rows: list[dict[str, Any]]
+    ran: list[str]
+    skipped: list[str]
+    failed: list[str]
+    table_csv: Path
+    table_parquet: Path
+    plots: list[Path]
+    wall_time: float
+    workers: int
+
+    def table(self):  # noqa: ANN201 - pandas is imported lazily
+        """The results as a pandas DataFrame (the rows of ``results.csv``)."""
+        return table_frame(self.rows)
+
+
+Progress = Callable[[int, int, "dict[str, Any] | None"], None]
+
+
+def summary_text(outcome: StudyOutcome) -> str:
+    """What a study did, for the command line to print: runs, workers, files, failures."""
+    study = outcome.study
+    rows = outcome.rows
+    axes = ", ".join(f"{a} ({len(v)})" for a, v in study.axes.items()) or "none (the base scenario once)"
+    if outcome.ran:
+        where = f"on {outcome.workers} worker{'s' if outcome.workers != 1 else ''}" if outcome.workers \
+            else "in this process"
+        done = f"{len(outcome.ran)} run now {where}, {len(outcome.skipped)} reused from earlier"
+    else:
+        done = "all reused from earlier (nothing to run; --redo runs them again)"
+    lines = [
+        f"Study: {study.name} ({study.source}), base {study.base.source}",
+        f"Axes: {axes}",
+        f"Runs: {len(rows)}: {done}, {len(outcome.failed)} failed",
+        f"Wall time: {outcome.wall_time:.3g} s",
+        f"Table: {outcome.table_csv} and {outcome.table_parquet.name} ({len(rows)} rows)",
+    ]
+    if outcome.plots:
+        lines.append(f"Plots: {len(outcome.plots)} PNG in {outcome.plots[0].parent}")
+    if outcome.failed:
+        lines.append("Failed runs (their logs and scenarios are in runs/<run id>/):")
+        for row in rows:
+            if row.get("status") != "ok":
+                first = (row.get("error") or "unknown error").strip().splitlines()[0]
+                lines.append(f"  {row['run_id']}: {first}")
+    return "\n".join(lines)
+
+
+def default_workers() -> int:
+    """Worker processes of a local cluster by default: the CPUs this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def run_study(
+    study: Study,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Progress | None = None,
+    redo: bool = False,
+    plots: bool | None = None,
+) -> StudyOutcome:
+    """Run every run of ``study`` that has no up-to-date result, then write the table and plots.
+
+    Args:
+        study: from :func:`load_study`.
+        workers: size of the local Dask cluster (default: one per CPU, at most one per
+            run); 0 runs one after another in this process, without Dask.
+        scheduler: address of an existing Dask scheduler (``tcp://host:8786``) instead
+            of a local cluster; its workers need cosim installed and the output folder
+            at the same path.
+        progress: called with (runs done, runs in total, the row just finished or None)
+            at the start and after every run.
+        redo: run every run again, even those with up-to-date results.
+        plots: write the plots (default: ``study.plots``).
+
+    Returns:
+        The rows, what ran and what was reused, and the files written.
+
+    Raises:
+        KeyboardInterrupt: Ctrl-C; the table of the runs finished so far is written first.
+        CosimError: the output folder cannot be written, or the scheduler cannot be reached.
+    """
+    started = time.perf_counter()
+    output = study.output
+    try:
+        output.mkdir(parents=True, exist_ok=True)
+        write_file(output / STUDY_FILE, study.text)
+    except OSError as exc:
+        raise CosimError(f"{output}: cannot write the study's output folder ({exc.strerror or exc})") from None
+    tasks = study.tasks()
+    rows: dict[str, dict[str, Any]] = {}
+    todo: list[RunTask] = []
+    for task in tasks:
+        stored = None if redo else finished_row(task)
+        if stored is not None:
+            rows[task.run_id] = stored
+        else:
+            todo.append(task)
+    skipped = [t.run_id for t in tasks if t.run_id in rows]
+    total = len(tasks)
+    if progress is not None:
+        progress(len(rows), total, None)
+
+    def finished(row: dict[str, Any]) -> None:
+        rows[row["run_id"]] = row
+        if progress is not None:
+            progress(len(rows), total, row)
+
+    used = 0
+    try:
+        if todo:
+            if workers == 0 and scheduler is None:
+                for task in todo:
+                    finished(execute_run(task))
+            else:
+                used = _run_on_dask(study, todo, workers, scheduler, finished)
+    except KeyboardInterrupt:
+        # Runs that finished on a worker but whose result had not come back yet count too.
+        for task in todo:
+            if task.run_id not in rows and (stored := finished_row(task)) is not None:
+                rows[task.run_id] = stored
+        write_table([rows[t.run_id] for t in tasks if t.run_id in rows], output)
+        raise
+    ordered = [rows[t.run_id] for t in tasks]
+    csv_path, parquet_path = write_table(ordered, output)
+    pngs = plot_study(ordered, study, output / PLOTS_FOLDER) if (study.plots if plots is None else plots) else []
+    return StudyOutcome(
+        study=study, rows=ordered, ran=[t.run_id for t in todo], skipped=skipped,
+        failed=[r["run_id"] for r in ordered if r.get("status") != "ok"],
+        table_csv=csv_path, table_parquet=parquet_path, plots=pngs,
+        wall_time=time.perf_counter() - started, workers=used,
+    )
+
+
+def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, scheduler: str | None,
+                 finished: Callable[[dict[str, Any]], None]) -> int:
+    """Submit the runs to a Dask cluster and hand every row to ``finished`` as it arrives; returns the workers."""
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    try:
+        if scheduler is not None:
+            try:
+                client = Client(scheduler, timeout="20s")
+            except (OSError, TimeoutError) as exc:
+                raise CosimError(f"--scheduler {scheduler}: cannot connect to the Dask scheduler ({exc})") from None
+            try:
+                client.wait_for_workers(1, timeout=WORKER_WAIT)
+            except TimeoutError:
+                client.close()
+                raise CosimError(f"--scheduler {scheduler}: the scheduler has no workers (waited {WORKER_WAIT:g} s; "
+                                 "start some with: dask worker ADDRESS --nthreads 1)") from None
+        else:
+            n = min(workers or default_workers(), len(todo))
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                   silence_logs=logging.ERROR)
+            client = Client(cluster)
+    except BaseException:
+        if cluster is not None:
+            cluster.close()
+        raise
+    try:
+        n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) if scheduler else \
+            len(cluster.workers)  # type: ignore[union-attr]
+        by_key: dict[str, RunTask] = {}
+        futures = []
+        for task in todo:
+            key = f"cosim-run-{study.name}-{task.run_id}-{task.fingerprint[:12]}"
+            future = client.submit(execute_run, task, key=key, pure=False, retries=0)
+            by_key[future.key] = task
+            futures.append(future)
+        try:
+            for future in as_completed(futures):
+                task = by_key[future.key]
+                try:
+                    row = future.result()
+                except Exception as exc:  # noqa: BLE001 - e.g. the worker died (KilledWorker)
+                    row = _lost_row(task, exc)
+                finished(row)
+        except BaseException:
+            client.cancel(futures)
+            raise
+        return n_workers
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _lost_row(task: RunTask, exc: BaseException) -> dict[str, Any]:
+    """The row of a run whose worker failed without returning one (recorded by the caller)."""
+    row = base_row(task)
+    row["error"] = f"the Dask worker failed: {error_text(exc)}"
+    row["log"] = f"{RUNS_FOLDER}/{task.run_id}/{LOG_FILE}"
+    row = jsonable_row(row)
+    try:
+        write_file(Path(task.folder) / RESULT_FILE, json.dumps({"fingerprint": task.fingerprint, "row": row}, indent=1))
+    except OSError:
+        pass
+    return row
+

@@ -1,0 +1,452 @@
+"""The study file and its runs: validation, the sweep, run ids and each run's generated inputs.
+
+A study file (TOML, ``docs/studies.md`` documents every key) names a base
+scenario and sweep axes; every combination of axis values is one *run*
+(:class:`RunTask`), with an id built from its values only (``vph-500_seed-3``)
+and every input as text: the run's scenario and its SUMO files with the
+sweep's edits (:mod:`cosim.sumo.files`). Nothing here runs anything.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import os
+import re
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Annotated, Any
+
+from pydantic import Field, PlainValidator, Strict, ValidationError, field_validator
+
+from cosim.core.roughness import ISO_CLASSES as ISO_ROAD_CLASSES
+from cosim.errors import ConfigError, CosimError
+from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
+from cosim.run.scenario import ROAD_CLASSES, SUMO_LEVELS, Scenario, list_bundled_scenarios, load_scenario
+from cosim.study.folder import RUNS_FOLDER, SUMO_FOLDER
+from cosim.sumo import (
+    SumoSet,
+    bundled_networks,
+    read_sumo_set,
+    set_speed_limit,
+    set_truck_share,
+    set_vehicles_per_hour,
+)
+from cosim.sumo.files import number_text
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+__all__ = [
+    "AXES",
+    "BUNDLED_LEVELS",
+    "DEFAULT_PERCENTILES",
+    "SUMO_AXES",
+    "RunTask",
+    "Study",
+    "error_text",
+    "id_part",
+    "load_study",
+    "number_text",
+    "parse_study",
+]
+
+ISO_CLASSES = tuple(ISO_ROAD_CLASSES)
+#: Bumped when what a run computes changes: older results are then redone.
+STUDY_FORMAT = 1
+#: Sweep axes in the order they vary (the last fastest) and their labels in run ids.
+AXES: dict[str, str] = {
+    "sumo_config": "cfg",
+    "vehicles_per_hour": "vph",
+    "truck_share": "trucks",
+    "speed_limit": "vmax",
+    "road_class": "road",
+    "seed": "seed",
+}
+#: Axes that edit the SUMO demand: the base scenario needs [traffic] (or the sumo_config axis).
+SUMO_AXES = ("sumo_config", "vehicles_per_hour", "truck_share", "speed_limit")
+#: Bundled demand levels (``sumo_networks/<level>.sumocfg``): the scenario's own list.
+BUNDLED_LEVELS = SUMO_LEVELS
+DEFAULT_PERCENTILES = (50.0, 95.0, 99.0)
+#: Road-profile seed when a random road class is swept without seeds.
+DEFAULT_SEED = 1
+#: Longest error message kept in a row.
+ERROR_LIMIT = 2000
+
+
+# --------------------------------------------------------------------------- the study file
+
+_NAME = Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
+_Text = Annotated[str, Strict(), Field(min_length=1)]
+_Positive = Annotated[float, Strict(), Field(gt=0)]
+_Share = Annotated[float, Strict(), Field(ge=0.0, le=1.0)]
+_Percent = Annotated[float, Strict(), Field(gt=0.0, le=100.0)]
+
+
+def _road_class(value: Any) -> str:
+    if not isinstance(value, str) or value not in ROAD_CLASSES:
+        raise fail(choices_message(value, ROAD_CLASSES, "road class"))
+    return value
+
+
+def _seeds(value: Any) -> tuple[int, ...]:
+    """``seeds = [1, 2, 3]`` or a count ``seeds = 3`` (meaning 1, 2, 3)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        if value < 1:
+            raise fail(f"a count of seeds must be >= 1 (got {value})")
+        return tuple(range(1, value + 1))
+    if not isinstance(value, (list, tuple)):
+        raise fail(f"expected an array of integers >= 0 (or a count), got {show(value)}")
+    problems = []
+    for i, item in enumerate(value):
+        if isinstance(item, bool) or not isinstance(item, int) or item < 0:
+            problems.append(((i,), f"expected an integer >= 0, got {show(item)}"))
+    if problems:
+        raise Problems(problems)
+    return tuple(value)
+
+
+class StudySection(ConfigModel):
+    """``[study]``: what to run and where the results go."""
+
+    name: _NAME | None = None
+    base: _Text
+    duration: _Positive | None = None
+    output: _Text | None = None
+    percentiles: tuple[_Percent, ...] = DEFAULT_PERCENTILES
+    plots: Annotated[bool, Strict()] = True
+
+
+class SweepSection(ConfigModel):
+    """``[sweep]``: the axes; every combination of their values is one run."""
+
+    sumo_config: tuple[_Text, ...] | None = None
+    vehicles_per_hour: tuple[_Positive, ...] | None = None
+    truck_share: tuple[_Share, ...] | None = None
+    speed_limit: tuple[_Positive, ...] | None = None
+    road_class: tuple[Annotated[str, PlainValidator(_road_class)], ...] | None = None
+    seeds: Annotated[tuple[int, ...], PlainValidator(_seeds)] | None = None
+
+    @field_validator("*")
+    @classmethod
+    def _non_empty_unique(cls, value: Any) -> Any:
+        if value is None:
+            return value
+        if len(value) == 0:
+            raise fail("expected at least one value (remove the key to keep the base scenario's)")
+        seen: dict[Any, int] = {}
+        for i, item in enumerate(value):
+            if item in seen:
+                raise fail(f"value {show(item)} is listed twice (at {seen[item]} and {i})")
+            seen[item] = i
+        return value
+
+
+class StudyFile(ConfigModel):
+    study: StudySection
+    sweep: SweepSection = SweepSection()
+
+
+# --------------------------------------------------------------------------- runs
+
+
+def id_part(text: str) -> str:
+    """``text`` with every character not allowed in a run id or a file name replaced by ``_``."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", text)
+
+
+@dataclass(frozen=True)
+class RunTask:
+    """Everything one run needs, as plain data: what a Dask worker receives.
+
+    Attributes:
+        run_id: deterministic from the parameter values.
+        folder: absolute path of ``<output>/runs/<run_id>`` (the output folder
+            must be reachable at this path from every worker).
+        parameters: the swept values of this run (axis name -> value), plus
+            ``sumo_seed`` and ``road_seed`` when they apply.
+        scenario_text: the run's scenario (TOML), written as ``scenario.toml``.
+        files: relative path in the run folder -> content (SUMO files, a road profile).
+        fingerprint: hash of every input; a stored result with another fingerprint is stale.
+        percentiles: of |value| per sensor, in percent.
+        error: why the run could not even be generated (e.g. a broken route file); it is then
+            recorded as failed without running.
+    """
+
+    run_id: str
+    folder: str
+    parameters: dict[str, Any]
+    scenario_text: str
+    files: dict[str, bytes]
+    fingerprint: str
+    percentiles: tuple[float, ...] = DEFAULT_PERCENTILES
+    error: str | None = None
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study: the base scenario, the axes and where results go.
+
+    Build one with :func:`load_study` or :func:`parse_study`.
+    """
+
+    name: str
+    source: str
+    text: str
+    base: Scenario
+    base_data: dict[str, Any]
+    base_dir: Path
+    study_dir: Path
+    duration: float | None
+    output: Path
+    axes: dict[str, tuple[Any, ...]]
+    percentiles: tuple[float, ...]
+    plots: bool
+    sumo_sets: dict[str, SumoSet | ConfigError] = field(default_factory=dict)
+
+    @property
+    def uses_sumo(self) -> bool:
+        return "traffic" in self.base_data or "sumo_config" in self.axes
+
+    @property
+    def swept(self) -> list[str]:
+        """Axis names in run-id order."""
+        return list(self.axes)
+
+    def combinations(self) -> list[dict[str, Any]]:
+        """Every combination of axis values, the last axis varying fastest."""
+        names = self.swept
+        return [dict(zip(names, combo)) for combo in itertools.product(*(self.axes[n] for n in names))]
+
+    def run_id(self, params: dict[str, Any]) -> str:
+        """``vph-500_trucks-0.1_seed-3``: the run's folder name, from its parameter values."""
+        if not params:
+            return "base"
+        parts = []
+        for name, value in params.items():
+            if name == "sumo_config":
+                text = self.sumo_label(value)
+            elif isinstance(value, str):
+                text = value
+            else:
+                text = number_text(value)
+            parts.append(f"{AXES[name]}-{id_part(text)}")
+        return "_".join(parts)
+
+    def sumo_label(self, value: str) -> str:
+        """How run ids and plots name a ``sumo_config`` value: its level or file stem (plus a hash if ambiguous)."""
+        stem = value if value in BUNDLED_LEVELS else Path(value).name.removesuffix(".sumocfg")
+        values = self.axes.get("sumo_config", ())
+        stems = [v if v in BUNDLED_LEVELS else Path(v).name.removesuffix(".sumocfg") for v in values]
+        if stems.count(stem) > 1:
+            stem += "-" + hashlib.sha1(value.encode()).hexdigest()[:6]
+        return stem
+
+    def tasks(self) -> list[RunTask]:
+        """The runs of the study, in sweep order."""
+        return [self.task(params) for params in self.combinations()]
+
+    def task(self, params: dict[str, Any]) -> RunTask:
+        """The :class:`RunTask` of one combination (generation problems become its ``error``)."""
+        run_id = self.run_id(params)
+        folder = self.output / RUNS_FOLDER / run_id
+        recorded = dict(params)
+        try:
+            body, files, seeds = self._generate(params)
+            error = None
+        except (CosimError, OSError, ValueError) as exc:
+            body, files, seeds, error = "", {}, {}, error_text(exc)
+        recorded.update(seeds)
+        # The fingerprint covers what the run computes from: not where the study or its base file lie.
+        digest = hashlib.sha256()
+        digest.update(f"cosim-study-{STUDY_FORMAT}\n{body}\n{self.percentiles}\n{error}\n".encode())
+        for name in sorted(files):
+            digest.update(name.encode() + b"\0" + hashlib.sha256(files[name]).digest())
+        described = ", ".join(f"{k} = {v}" for k, v in params.items()) or "the base scenario as it is"
+        header = (f"# Run {run_id} of study {self.name} ({self.source}), generated by cosim study from "
+                  f"{self.base.source}: {described}\n")
+        return RunTask(run_id, str(folder), recorded, header + body if body else "", files, digest.hexdigest(),
+                       self.percentiles, error)
+
+    # ---------------------------------------------------------------- generation
+    def _generate(self, params: dict[str, Any]) -> tuple[str, dict[str, bytes], dict[str, Any]]:
+        """The run's scenario TOML (without its header comment), its input files, and the seeds used."""
+        data = copy.deepcopy(self.base_data)
+        files: dict[str, bytes] = {}
+        seeds: dict[str, Any] = {}
+        seed = params.get("seed")
+        # [output]: the log goes where the study says; no extra CSV.
+        output = data.get("output")
+        if isinstance(output, dict):
+            output.pop("log", None)
+            output.pop("csv", None)
+            if not output:
+                data.pop("output")
+        # [road]
+        road = dict(data.get("road") or {})
+        if "road_class" in params:
+            cls = params["road_class"]
+            road = {"class": cls}
+            if cls in ISO_CLASSES:
+                road["seed"] = seed if seed is not None else int((data.get("road") or {}).get("seed", DEFAULT_SEED))
+        elif seed is not None and road.get("class") in ISO_CLASSES:
+            road["seed"] = seed
+        if road.get("profile"):
+            source = self.base_dir / road["profile"]
+            name = f"inputs/{Path(road['profile']).name}"
+            files[name] = source.read_bytes()
+            road["profile"] = name
+        if road:
+            data["road"] = road
+        if road.get("class") in ISO_CLASSES:
+            seeds["road_seed"] = road.get("seed")
+        # [traffic] or [[vehicles]]
+        if self.uses_sumo:
+            traffic = dict(data.get("traffic") or {})
+            value = params.get("sumo_config", traffic.get("sumo_config"))
+            sumo = self.sumo_sets[value]
+            if isinstance(sumo, ConfigError):
+                raise sumo
+            if "vehicles_per_hour" in params:
+                sumo = set_vehicles_per_hour(sumo, params["vehicles_per_hour"])
+            if "truck_share" in params:
+                sumo = set_truck_share(sumo, params["truck_share"])
+            if "speed_limit" in params:
+                sumo = set_speed_limit(sumo, params["speed_limit"])
+            for name, content in sumo.files.items():
+                files[f"{SUMO_FOLDER}/{name}"] = content
+            traffic["sumo_config"] = f"{SUMO_FOLDER}/{sumo.config}"
+            if seed is not None:
+                traffic["seed"] = seed
+            if self.duration is not None:
+                traffic["end"] = float(traffic.get("begin", 0.0)) + self.duration
+                solver = data.get("solver")
+                if isinstance(solver, dict) and "duration" in solver:
+                    solver["duration"] = self.duration
+            data["traffic"] = traffic
+            seeds["sumo_seed"] = traffic.get("seed")
+        elif self.duration is not None:
+            data.setdefault("solver", {})["duration"] = self.duration
+        from cosim.run.logged import toml_dumps
+
+        return toml_dumps(data), files, seeds
+
+
+def error_text(exc: BaseException) -> str:
+    """What a row records of a failure: the message (with the exception's type unless it is cosim's), bounded."""
+    text = str(exc).strip() or type(exc).__name__
+    if not isinstance(exc, CosimError):
+        text = f"{type(exc).__name__}: {text}"
+    return text[:ERROR_LIMIT]
+
+
+def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[str] = ".",
+                output: str | os.PathLike[str] | None = None) -> Study:
+    """Validate study TOML text and load its base scenario and SUMO configs.
+
+    Args:
+        text: the TOML document.
+        source: how to name it in error messages (the file path).
+        base_dir: the study file's folder (``study.base`` and ``sweep.sumo_config`` paths are relative to it).
+        output: the output folder instead of ``study.output`` (relative to the current folder).
+
+    Raises:
+        ConfigError: the study file is malformed, its base scenario or a SUMO config cannot be
+            read, or an axis does not fit the base scenario (e.g. ``vehicles_per_hour`` without
+            SUMO traffic). Messages name the file and the key.
+    """
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
+    try:
+        parsed = StudyFile.model_validate(raw)
+    except ValidationError as exc:
+        raise config_error(source, StudyFile, exc) from None
+    study_dir = Path(base_dir)
+    sec = parsed.study
+    base_path = study_dir / sec.base
+    try:
+        if base_path.is_file() or sec.base not in list_bundled_scenarios():
+            base = load_scenario(base_path)  # a file next to the study (a missing one: its error)
+        else:
+            base = load_scenario(sec.base)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: study.base: {exc}") from None
+    base_data = tomllib.loads(base.text)
+    scenario_dir = base_path.parent if base_path.is_file() else _bundled_scenarios_dir()
+    name = sec.name or (Path(source).stem if source != "<study>" else base.title)
+    axes: dict[str, tuple[Any, ...]] = {}
+    sweep = parsed.sweep
+    for axis in AXES:
+        values = getattr(sweep, "seeds" if axis == "seed" else axis)
+        if values is not None:
+            axes[axis] = tuple(values)
+    has_traffic = "traffic" in base_data
+    if "vehicles" in base_data or not has_traffic:
+        for axis in SUMO_AXES:
+            if axis in axes:
+                raise ConfigError(
+                    f"{source}: sweep.{axis}: needs SUMO traffic, but the base scenario {base.source} has "
+                    f"{'[[vehicles]]' if base_data.get('vehicles') else 'no [traffic]'}; give a base with "
+                    "[traffic] (docs/studies.md)")
+    sumo_sets: dict[str, SumoSet | ConfigError] = {}
+    if has_traffic and "vehicles" not in base_data:
+        configs: list[tuple[str, Path, str]] = []
+        if "sumo_config" in axes:
+            for i, value in enumerate(axes["sumo_config"]):
+                configs.append((value, _config_path(value, study_dir, f"{source}: sweep.sumo_config[{i}]"),
+                                f"sweep.sumo_config[{i}]"))
+        else:
+            value = (base_data.get("traffic") or {}).get("sumo_config")
+            if not isinstance(value, str):
+                raise ConfigError(f"{base.source}: traffic.sumo_config: required key is missing")
+            configs.append((value, _config_path(value, scenario_dir, f"{base.source}: traffic.sumo_config"),
+                            "traffic.sumo_config"))
+        for value, path, key in configs:
+            label = value if value in BUNDLED_LEVELS else path.stem
+            try:
+                sumo_sets[value] = read_sumo_set(path, label)
+            except ConfigError as exc:  # broken content: those runs fail, the others go on
+                sumo_sets[value] = ConfigError(f"{key}: {exc}")
+    out = Path(output) if output is not None else Path(sec.output or f"studies/{name}")
+    return Study(
+        name=name, source=source, text=text, base=base, base_data=base_data, base_dir=scenario_dir,
+        study_dir=study_dir, duration=sec.duration, output=out.resolve(), axes=axes,
+        percentiles=tuple(sec.percentiles), plots=sec.plots, sumo_sets=sumo_sets,
+    )
+
+
+def _bundled_scenarios_dir() -> Path:
+    from importlib import resources
+
+    return Path(str(resources.files("cosim").joinpath("scenarios")))
+
+
+def _config_path(value: str, folder: Path, where: str) -> Path:
+    if value in BUNDLED_LEVELS:
+        return bundled_networks() / f"{value}.sumocfg"
+    path = Path(value) if Path(value).is_absolute() else folder / value
+    if not path.is_file():
+        raise ConfigError(f"{where}: file not found: {path} (a bundled level is one of "
+                          f"{', '.join(BUNDLED_LEVELS)}; a path is relative to the file that names it)")
+    return path
+
+
+def load_study(path: str | os.PathLike[str], output: str | os.PathLike[str] | None = None) -> Study:
+    """Load and validate a study file (see :func:`parse_study`).
+
+    Raises:
+        ConfigError: the file is missing or unreadable, or its content is invalid.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise ConfigError(f"{path}: cannot read the study file ({reason})") from None
+    return parse_study(text, str(path), base_dir=path.parent, output=output)
+

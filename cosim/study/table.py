@@ -1,0 +1,194 @@
+"""A study's numbers: each run's row of statistics from its log, and the table of all rows.
+
+:func:`run_statistics` reduces a finished run (its result and its log) to
+peaks, percentiles, RMS and the dynamic amplification factor against a
+quasi-static run of the same traffic (:mod:`cosim.core.quasistatic`) per
+sensor, and vehicle counts; :func:`write_table` writes the rows as
+``results.csv`` and ``results.parquet``; :func:`plot_study` hands the table to
+:func:`cosim.plots.plot_sweep`.
+"""
+from __future__ import annotations
+
+import io
+import json
+import math
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from cosim.core.quasistatic import daf, quasi_static
+from cosim.run.scenario import Scenario
+from cosim.study.folder import TABLE_CSV, TABLE_PARQUET, write_file
+from cosim.study.logs import logged_sensors, logged_traffic
+from cosim.study.spec import AXES, RunTask, Study, number_text
+
+__all__ = [
+    "AXIS_LABELS",
+    "base_row",
+    "jsonable_row",
+    "plot_study",
+    "plotted_statistics",
+    "run_statistics",
+    "table_frame",
+    "write_table",
+]
+
+#: Columns that hold text; every other column is numeric.
+TEXT_COLUMNS = ("error", "heaviest_id", "log", "status", "run_id", "road_class", "sumo_config")
+_FIRST = ("run_id", "status", *AXES, "sumo_seed", "road_seed", "duration", "steps")
+_LAST = ("vehicles", "max_on_deck", "heaviest_kg", "heaviest_id", "liftoff_events", "liftoff_steps",
+         "wall_time", "wall_time_total", "log", "error")
+#: x-axis label of each swept axis in the plots.
+AXIS_LABELS = {
+    "sumo_config": "SUMO demand",
+    "vehicles_per_hour": "vehicles per hour per direction",
+    "truck_share": "truck share",
+    "speed_limit": "speed limit [m/s]",
+    "road_class": "road class",
+    "seed": "seed",
+}
+#: Plotted columns that are not per sensor: label and display factor.
+GLOBAL_STATISTICS = {
+    "vehicles": ("vehicles on the deck during the run", 1.0),
+    "max_on_deck": ("most vehicles on the deck at once", 1.0),
+    "heaviest_kg": ("heaviest vehicle [t]", 1e-3),
+    "liftoff_events": ("lift-off events", 1.0),
+}
+
+
+# --------------------------------------------------------------------------- one run's row
+
+
+def base_row(task: RunTask) -> dict[str, Any]:
+    """The row a run starts from: its id, its parameters and ``status = "error"`` until it succeeds."""
+    return {"run_id": task.run_id, "status": "error", **task.parameters}
+
+
+def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: Sequence[float]) -> dict[str, Any]:
+    """Peaks, percentiles, RMS, quasi-static peak and DAF per sensor; vehicle counts of the run.
+
+    Args:
+        scenario, bridge: what ran.
+        outcome: the finished logged run (:class:`cosim.run.logged.RunOutcome`).
+        percentiles: of |value| per sensor, in percent.
+    """
+    result = outcome.result
+    sensors = scenario.sensors_core()
+    names = [s.name for s in sensors]
+    series = logged_sensors(outcome.log_path, names)
+    if scenario.traffic is not None:  # the logged SUMO frames (empty ones are not in the log)
+        traffic = logged_traffic(outcome.log_path, bridge.length, scenario.traffic.step, until=outcome.duration)
+    else:
+        traffic = scenario.build_vehicles()
+    qs = quasi_static(bridge, traffic, outcome.duration, scenario.solver.dt, sensors, scenario.solver.gravity)
+    row: dict[str, Any] = {"duration": outcome.duration, "steps": result.steps}
+    for name in names:
+        lo, hi = result.sensor_min[name], result.sensor_max[name]
+        peak = max(abs(lo), abs(hi))
+        values = np.abs(series[name])
+        row[f"{name}.min"] = lo
+        row[f"{name}.max"] = hi
+        row[f"{name}.peak"] = peak
+        for q in percentiles:
+            row[f"{name}.p{number_text(q)}"] = float(np.percentile(values, q)) if len(values) else None
+        row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
+        row[f"{name}.static_peak"] = qs.peak[name]
+        row[f"{name}.daf"] = daf(peak, qs.peak[name])
+    row.update({
+        "vehicles": len(result.vehicle_ids),
+        "max_on_deck": result.max_on_deck,
+        "heaviest_kg": qs.heaviest,
+        "heaviest_id": qs.heaviest_id,
+        "liftoff_events": result.liftoff_events,
+        "liftoff_steps": result.liftoff_steps,
+        "wall_time": outcome.wall_time,
+    })
+    return row
+
+
+def jsonable_row(row: dict[str, Any]) -> dict[str, Any]:
+    """Plain JSON types, non-finite numbers as None: what result.json stores and the table reads."""
+    out = {}
+    for key, value in row.items():
+        if isinstance(value, (np.floating, np.integer)):
+            value = value.item()
+        if isinstance(value, float) and not math.isfinite(value):
+            value = None
+        out[key] = value
+    return json.loads(json.dumps(out))
+
+
+# --------------------------------------------------------------------------- the table
+
+
+def table_frame(rows: list[dict[str, Any]]):  # noqa: ANN201 - pandas is imported lazily
+    """The rows as a pandas DataFrame: run id and status first, the axes, statistics, then counts and files."""
+    import pandas as pd
+
+    keys: dict[str, None] = {"run_id": None, "status": None}
+    for row in rows:
+        keys.update(dict.fromkeys(row))
+    first = [k for k in _FIRST if k in keys]
+    last = [k for k in _LAST if k in keys]
+    middle = [k for k in keys if k not in first and k not in last]
+    columns = first + middle + last
+    frame = pd.DataFrame([{k: row.get(k) for k in columns} for row in rows], columns=columns)
+    for name in TEXT_COLUMNS:
+        if name in frame:
+            frame[name] = frame[name].fillna("").astype(str)
+    for name in columns:
+        if frame[name].dtype == object and name not in TEXT_COLUMNS:
+            frame[name] = pd.to_numeric(frame[name], errors="coerce")
+    return frame
+
+
+def write_table(rows: list[dict[str, Any]], output: Path) -> tuple[Path, Path]:
+    """``results.csv`` and ``results.parquet`` in ``output``: one row per run, SI units."""
+    frame = table_frame(rows)
+    csv_path, parquet_path = output / TABLE_CSV, output / TABLE_PARQUET
+    text = io.StringIO()
+    frame.to_csv(text, index=False)
+    write_file(csv_path, text.getvalue())
+    data = io.BytesIO()
+    frame.to_parquet(data, index=False)
+    write_file(parquet_path, data.getvalue())
+    return csv_path, parquet_path
+
+
+# --------------------------------------------------------------------------- plots
+
+
+def plotted_statistics(study: Study, frame: Any) -> list[tuple[str, str, float]]:
+    """(column, label, display factor) of every statistic plotted: each sensor's peak, RMS and DAF, and counts."""
+    from cosim.run.logged import DISPLAY_UNITS
+
+    out = []
+    for sensor in study.base.sensors:
+        unit, factor = DISPLAY_UNITS.get(sensor.quantity, ("SI", 1.0))
+        for stat, what in (("peak", "peak |value|"), ("rms", "RMS"), ("daf", "DAF")):
+            column = f"{sensor.name}.{stat}"
+            if column not in frame or not np.isfinite(frame[column].to_numpy(dtype=float)).any():
+                continue
+            if stat == "daf":
+                out.append((column, f"{sensor.name}: dynamic amplification factor", 1.0))
+            else:
+                out.append((column, f"{sensor.name}: {what} [{unit}]", factor))
+    for column, (label, factor) in GLOBAL_STATISTICS.items():
+        if column in frame:
+            out.append((column, label, factor))
+    return out
+
+
+def plot_study(rows: list[dict[str, Any]], study: Study, folder: Path) -> list[Path]:
+    """One PNG per statistic (``<folder>/<column>.png``) with a panel per swept axis (failed runs left out).
+
+    See :func:`cosim.plots.plot_sweep` for what a panel shows.
+    """
+    from cosim.plots import plot_sweep
+
+    frame = table_frame(rows)
+    ok = frame[frame["status"] == "ok"] if len(frame) else frame
+    ticks = {"sumo_config": {v: study.sumo_label(v) for v in study.axes.get("sumo_config", ())}}
+    return plot_sweep(ok, study.axes, plotted_statistics(study, ok), folder, title=study.name,
+                      axis_labels=AXIS_LABELS, tick_labels=ticks)
