@@ -28,7 +28,8 @@ WORKER = r"""
 import json, sys, tempfile, time
 from pathlib import Path
 from cosim.run.scenario import load_scenario
-from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
 from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks
 from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 

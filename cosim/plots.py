@@ -15,10 +15,6 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 # --------------------------------------------------------------------------- common
-from pathlib import Path
-from typing import Any, Mapping, Sequence
-
-import numpy as np
 import numpy.typing as npt
 
 from cosim.errors import CosimError

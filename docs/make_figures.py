@@ -20,7 +20,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from cosim import testing as ct  # noqa: E402
-from cosim.run.logged import sensor_series  # noqa: E402
+from cosim.log import sensor_series  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

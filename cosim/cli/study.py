@@ -7,7 +7,7 @@ from typing import Any
 
 
 def cmd_study(args: argparse.Namespace) -> int:
-    from cosim.study.study import load_study, run_study, summary_text
+    from cosim.study import load_study, run_study, summary_text
 
     study = load_study(args.study, output=args.out)
     bar: Any = None

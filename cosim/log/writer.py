@@ -499,9 +499,3 @@ class TrafficLogger:
         self.rec.write(TOPIC_TRAFFIC, frame.t, {
             "t": frame.t, "ids": list(frame.ids), "x": frame.x.tolist(), "y": frame.y.tolist(),
             "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
-
-
-# --------------------------------------------------------------------------- compatibility (issue 9)
-# cosim.study and tests/integration/test_{sumo,studies}.py still import the reader from here; they
-# move to ``cosim.log`` when their owners update the call sites. Remove these three names then.
-from .reader import file_is_complete, read_log, traffic_from_log  # noqa: E402, F401

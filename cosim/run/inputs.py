@@ -9,7 +9,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from cosim.errors import ConfigError
+from cosim.sumo import sumo_input_files
 
 from .scenario import Scenario
 
@@ -46,22 +46,3 @@ def input_files(scenario: Scenario) -> list[InputFile]:
             key = "traffic.sumo_config" if path == sumo_cfg else ""
             found.append(InputFile(key, str(path), path, f"sumo/{rel.as_posix()}"))
     return found
-
-
-def sumo_input_files(config: Path) -> list[Path]:
-    """The SUMO config and the net, route and additional files it names (parsed as XML, never run)."""
-    import xml.etree.ElementTree as ET
-
-    try:
-        root = ET.parse(config).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise ConfigError(f"{config}: not a readable SUMO config ({exc})") from None
-    files = [config]
-    for tag in ("net-file", "route-files", "additional-files"):
-        for element in root.iter(tag):
-            for name in element.get("value", "").split(","):
-                if name.strip():
-                    path = (config.parent / name.strip())
-                    if path.is_file() and path not in files:
-                        files.append(path)
-    return files

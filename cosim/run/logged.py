@@ -278,13 +278,3 @@ def run_logged(
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,
         wall_time=wall, log_bytes=log_path.stat().st_size,
     )
-
-
-# --------------------------------------------------------------------------- compatibility (issue 9)
-# cosim.study and tests/integration/test_studies.py import these from here; they move to their own
-# modules (see each name's home) when those call sites are updated. Remove these names then.
-from cosim.log.reader import sensor_series  # noqa: E402, F401
-
-from .replay import compare_sensors  # noqa: E402, F401
-from .toml_writer import toml_dumps  # noqa: E402, F401
-from .units import DISPLAY_UNITS  # noqa: E402, F401

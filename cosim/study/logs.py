@@ -11,8 +11,7 @@ from typing import Sequence
 import numpy as np
 
 from cosim.core.traffic import FrameTraffic
-from cosim.log.writer import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, file_is_complete, read_log, traffic_from_log
-from cosim.run.logged import sensor_series
+from cosim.log import file_is_complete, read_traffic, sensor_series
 
 __all__ = ["log_is_complete", "logged_sensors", "logged_traffic"]
 
@@ -30,5 +29,5 @@ def logged_sensors(path: str | os.PathLike[str], names: Sequence[str]) -> dict[s
 
 def logged_traffic(path: str | os.PathLike[str], length: float, step: float, until: float) -> FrameTraffic:
     """The SUMO frames of the log as a traffic source on a bridge of ``length`` (empty frames filled back in)."""
-    contents = read_log(path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-    return traffic_from_log(contents, length, step, until=until)
+    traffic, _ = read_traffic(path, length, step, until=until)
+    return traffic

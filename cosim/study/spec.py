@@ -330,7 +330,7 @@ class Study:
             seeds["sumo_seed"] = traffic.get("seed")
         elif self.duration is not None:
             data.setdefault("solver", {})["duration"] = self.duration
-        from cosim.run.logged import toml_dumps
+        from cosim.run.toml_writer import toml_dumps
 
         return toml_dumps(data), files, seeds
 

@@ -161,7 +161,7 @@ def write_table(rows: list[dict[str, Any]], output: Path) -> tuple[Path, Path]:
 
 def plotted_statistics(study: Study, frame: Any) -> list[tuple[str, str, float]]:
     """(column, label, display factor) of every statistic plotted: each sensor's peak, RMS and DAF, and counts."""
-    from cosim.run.logged import DISPLAY_UNITS
+    from cosim.run.units import DISPLAY_UNITS
 
     out = []
     for sensor in study.base.sensors:

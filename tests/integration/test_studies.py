@@ -26,8 +26,9 @@ import pytest
 
 import cosim
 from cosim.errors import ConfigError
-from cosim.log.writer import file_is_complete
-from cosim.run.logged import compare_sensors, run_logged
+from cosim.log import file_is_complete
+from cosim.run.logged import run_logged
+from cosim.run.replay import compare_sensors
 from cosim.run.scenario import load_scenario
 from cosim.study import load_study, parse_study, run_study, summary_text
 from cosim.sumo import bundled_networks
@@ -335,7 +336,7 @@ def test_a_broken_demand_file_fails_its_runs_only(tmp_path):
 
 
 def test_sweeping_the_speed_limit_slows_the_traffic(tmp_path):
-    from cosim.log.writer import TOPIC_TRAFFIC, read_log
+    from cosim.log import TOPIC_TRAFFIC, read_log
 
     study_path = _write_study(tmp_path, STUDY.replace(
         "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", "speed_limit = [10.0, 25.0]\nseeds = [3]"))

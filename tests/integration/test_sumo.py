@@ -248,7 +248,7 @@ def test_sumo_config_errors_are_one_line_naming_the_file(tmp_path):
 
 
 def test_replaying_a_sumo_log_reproduces_the_sensors_bit_for_bit(paper_bridge, tmp_path):
-    from cosim.log.writer import TOPIC_SENSORS, BlockLogger, LogRecorder, TrafficLogger, read_log, traffic_from_log
+    from cosim.log import TOPIC_SENSORS, BlockLogger, LogRecorder, TrafficLogger, read_log, traffic_from_log
 
     sensors = [Sensor("mid", 20.0, 0.0), Sensor("acc", 20.0, 3.0, "acceleration")]
     names = [s.name for s in sensors]
@@ -332,7 +332,7 @@ def test_cli_runs_sumo_traffic_and_replays_it_bit_for_bit(tmp_path):
     assert other.returncode == 0, other.stderr
     assert "its SUMO traffic" in other.stdout and "Bridge: 40 m, 16 elements" in other.stdout
     # The inputs travel with the log (``cosim info`` lists them; tested with the logging commands).
-    from cosim.log.writer import read_log
+    from cosim.log import read_log
 
     attached = read_log(tmp_path / "a.mcap").attachments
     for name in ("heavy.sumocfg", "bridge.net.xml", "vtypes.add.xml", "heavy.rou.xml"):
@@ -351,7 +351,7 @@ def test_cli_reports_a_broken_sumo_config_and_finishes_the_log(tmp_path):
 
 
 def read_log_status(path):
-    from cosim.log.writer import read_log
+    from cosim.log import read_log
 
     return read_log(path).final_status
 
