@@ -457,7 +457,7 @@ def spectrum(t: npt.ArrayLike, values: npt.ArrayLike, pad: int = 8
     window = np.hanning(len(x))
     n = int(2 ** math.ceil(math.log2(len(x) * max(pad, 1))))
     amplitude = 2.0 * np.abs(np.fft.rfft((x - x.mean()) * window, n)) / window.sum()
-    return np.fft.rfftfreq(n, dt), amplitude
+    return np.fft.rfftfreq(n, dt).astype(np.float64), amplitude
 
 
 def dominant_frequency(t: npt.ArrayLike, values: npt.ArrayLike, band: tuple[float, float] | None = None,

@@ -101,7 +101,8 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
         f"Static load case: {STATIC_LOAD_N / 1e3:g} kN downward at x = {load['x']:g} m "
         f"(mid-span of span {load['span']}); deck displacement w [mm], positive up",
     ]
-    rows = [(s.name, s.quantity, s.x, s.y, [c["sensors"][s.name] for c in cases]) for s in scenario.sensors]
+    rows: list[tuple[str, str, float, float | None, list[float]]] = [
+        (s.name, s.quantity, s.x, s.y, [c["sensors"][s.name] for c in cases]) for s in scenario.sensors]
     rows.append(("(under the load)", "displacement", load["x"], None, [c["w_load_point"] for c in cases]))
     width = max(len(row[0]) for row in rows) + 2
     lines.append(f"  {'point':<{width}}{'quantity':<16}{'x [m]':>8}{'y [m]':>9}" + "".join(f"{h:>22}" for h in heads))

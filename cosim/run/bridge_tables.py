@@ -333,7 +333,8 @@ class DampingConfig(ConfigModel):
         """The :mod:`cosim.core.bridge` damping specification."""
         if self.ratios is not None:
             assert self.modes is not None
-            return RayleighDamping(ratios=tuple(self.ratios), modes=tuple(self.modes))
+            (z1, z2), (m1, m2) = self.ratios, self.modes  # two of each, checked by the validators
+            return RayleighDamping(ratios=(z1, z2), modes=(m1, m2))
         assert self.alpha is not None and self.beta is not None
         return ExplicitDamping(alpha=self.alpha, beta=self.beta)
 

@@ -15,6 +15,7 @@ import difflib
 import json
 import math
 import types
+from collections.abc import Sequence
 from typing import Annotated, Any, Union, get_args, get_origin
 
 from pydantic import (
@@ -37,9 +38,9 @@ FUTURE_SECTIONS: dict[str, str] = {}
 class Problems(ValueError):
     """Problems found by a validator, each with a key path relative to the value checked."""
 
-    def __init__(self, problems: list[tuple[tuple[str | int, ...], str]]) -> None:
+    def __init__(self, problems: Sequence[tuple[Sequence[str | int], str]]) -> None:
         super().__init__("; ".join(msg for _, msg in problems))
-        self.problems = problems
+        self.problems = [(tuple(loc), msg) for loc, msg in problems]
 
 
 def fail(message: str, *loc: str | int) -> Problems:
@@ -249,7 +250,7 @@ def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> Co
     for error in errors:
         if error["type"] == "missing" and tuple(error["loc"]) in suggested:
             continue
-        for key, message in _format_one(root, error):
+        for key, message in _format_one(root, dict(error)):
             lines.append(f"{source}: {key}: {message}")
     if len(lines) > 1:
         more = len(lines) - 1

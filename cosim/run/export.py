@@ -24,8 +24,8 @@ from .outputs import atomic_write, check_new_file
 EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS)
 #: Columns of each topic's CSV but the sensors' (``t,<sensor names>``).
 VEHICLE_COLUMNS = ("t", *(f.name for f in VEHICLE_FIELDS))
-EVENT_COLUMNS = tuple(EVENTS_SCHEMA["properties"])
-STATUS_COLUMNS = tuple(STATUS_SCHEMA["properties"])
+EVENT_COLUMNS: tuple[str, ...] = tuple(EVENTS_SCHEMA["properties"])  # type: ignore[arg-type]
+STATUS_COLUMNS: tuple[str, ...] = tuple(STATUS_SCHEMA["properties"])  # type: ignore[arg-type]
 
 
 def _cell(value: Any) -> str:

@@ -63,4 +63,4 @@ def plot_modes(bridge: BridgeModel, modal: ModalResult, path: str | os.PathLike[
     titles = [f"mode {i + 1}: {modal.f_hz[i]:.3f} Hz, {modal.kinds[i]}" for i in range(n)]
     supports_x = np.concatenate([[0.0], np.cumsum(bridge.spans)])
     half_width = max(abs(bridge.section.deck_y[0]), abs(bridge.section.deck_y[1]), 1.0)
-    return plots.mode_shapes(x, shapes, titles, supports_x, half_width, path)
+    return plots.mode_shapes(x, shapes, titles, supports_x, half_width, Path(path))

@@ -301,7 +301,7 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
         for task in todo:
             key = f"cosim-run-{study.name}-{task.run_id}-{task.fingerprint[:12]}"
             future = client.submit(execute_run, task, key=key, pure=False, retries=0)
-            by_key[future.key] = task
+            by_key[str(future.key)] = task
             futures.append(future)
         try:
             for future in as_completed(futures):

@@ -307,7 +307,7 @@ class Study:
         if self.uses_sumo:
             traffic = dict(data.get("traffic") or {})
             value = params.get("sumo_config", traffic.get("sumo_config"))
-            sumo = self.sumo_sets[value]
+            sumo = self.sumo_sets[str(value)]
             if isinstance(sumo, ConfigError):
                 raise sumo
             if "vehicles_per_hour" in params:

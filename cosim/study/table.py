@@ -18,6 +18,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from cosim.core.quasistatic import daf, quasi_static
+from cosim.core.traffic import FrameTraffic, ScriptedTraffic
 from cosim.run.scenario import Scenario
 from cosim.study.folder import TABLE_CSV, TABLE_PARQUET, write_file
 from cosim.study.logs import logged_sensors, logged_traffic
@@ -77,6 +78,7 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
     sensors = scenario.sensors_core()
     names = [s.name for s in sensors]
     series = logged_sensors(outcome.log_path, names)
+    traffic: FrameTraffic | ScriptedTraffic
     if scenario.traffic is not None:  # the logged SUMO frames (empty ones are not in the log)
         traffic = logged_traffic(outcome.log_path, bridge.length, scenario.traffic.step, until=outcome.duration)
     else:

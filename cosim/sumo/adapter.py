@@ -23,7 +23,7 @@ import os
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Any, Callable, Sequence
 
 import numpy as np
 
@@ -125,7 +125,7 @@ class SumoTraffic:
         self.models: dict[str, VehicleModel] = {}
         self.frames: FrameTraffic | None = None
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
-        self.libsumo = None
+        self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
         self.sumo_steps = 0
         self.teleports = 0
 

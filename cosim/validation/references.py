@@ -190,7 +190,7 @@ def lateral_torsional_frequencies_hz(
              [-w^2 rho A z_s, GJ k^2 + E I_w k^4 - w^2 rho (I_ps + I_w k^2)]]) = 0
     """
     E, G, rho = material.E, material.G, material.rho
-    out = []
+    out: list[float] = []
     for n in range(1, n_max + 1):
         k = n * np.pi / L
         k11, k22 = E * section.I_z * k**4, G * section.J * k**2 + E * section.I_w * k**4
