@@ -34,11 +34,13 @@ import numpy.typing as npt
 from cosim import __version__
 from cosim.core.bridge import BridgeModel, ExplicitDamping, PointLoad, build_bridge
 from cosim.core.element import DOF_INDEX, NODE_DOFS
+from cosim.core.section import SectionProperties
+from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 from cosim.errors import CosimError
+
 from .references import (
     STEEL,
     YANG_YAU,
-    yang_yau_case,
     cantilever_tip_load_deflection,
     doubly_symmetric_section,
     euler_bernoulli_ss_frequency_hz,
@@ -51,9 +53,8 @@ from .references import (
     ss_point_load_deflection,
     timoshenko_ss_frequency_hz,
     torsional_frequencies_hz,
+    yang_yau_case,
 )
-from cosim.core.section import SectionProperties
-from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 
 __all__ = ["CaseResult", "ValidationReport", "ValidationSettings", "run_validation", "study_names"]
 
