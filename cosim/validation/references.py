@@ -68,7 +68,8 @@ def rectangle_section(b: float, h: float, shear_factor: float = 5.0 / 6.0) -> Se
     A = b * h
     return SectionProperties(
         A=A, y_c=0.0, z_c=0.0, I_y=b * h**3 / 12, I_z=h * b**3 / 12, I_yz=0.0, y_s=0.0, z_s=0.0,
-        J=rectangle_torsion_constant(b, h), I_w=0.0, A_sy=shear_factor * A, A_sz=shear_factor * A, deck_y=(-b / 2, b / 2),
+        J=rectangle_torsion_constant(b, h), I_w=0.0, A_sy=shear_factor * A, A_sz=shear_factor * A,
+        deck_y=(-b / 2, b / 2),
     )
 
 
@@ -134,12 +135,14 @@ def cantilever_tip_load_deflection(
 # --------------------------------------------------------------------------- bending frequencies
 
 def euler_bernoulli_ss_frequency_hz(n: npt.ArrayLike, L: float, EI: float, m: float) -> npt.NDArray[np.float64]:
-    """``f_n = (n pi / L)^2 sqrt(EI / m) / (2 pi)``, Hz: simply supported Euler-Bernoulli beam, mass ``m`` per length."""
+    """``f_n = (n pi / L)^2 sqrt(EI / m) / (2 pi)``, Hz: simply supported Euler-Bernoulli beam, ``m`` per length."""
     n = np.asarray(n, dtype=float)
     return (n * np.pi / L) ** 2 * np.sqrt(EI / m) / (2 * np.pi)
 
 
-def timoshenko_ss_frequency_hz(n: npt.ArrayLike, L: float, material: Material, section: SectionProperties) -> npt.NDArray[np.float64]:
+def timoshenko_ss_frequency_hz(
+    n: npt.ArrayLike, L: float, material: Material, section: SectionProperties
+) -> npt.NDArray[np.float64]:
     """Vertical bending frequencies (Hz) of a simply supported Timoshenko beam, mode numbers ``n``.
 
     Smaller root of the frequency equation (Han, Benaroya & Wei, JSV 225, 1999):
@@ -185,7 +188,9 @@ def midspan_torque_twist(
     return T / (2 * GJ) * shape
 
 
-def torsional_frequencies_hz(n: npt.ArrayLike, L: float, material: Material, section: SectionProperties) -> npt.NDArray[np.float64]:
+def torsional_frequencies_hz(
+    n: npt.ArrayLike, L: float, material: Material, section: SectionProperties
+) -> npt.NDArray[np.float64]:
     """Torsional frequencies (Hz) with fork supports (warping free), S = C.
 
     ``omega^2 = (GJ k^2 + E I_w k^4) / (rho I_p + rho I_w k^2)``, ``k = n pi / L``
