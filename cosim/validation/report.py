@@ -12,9 +12,9 @@ and hands the results to :func:`write_report`, which draws each figure through
         print(case.name, case.error, case.tolerance, case.passed)
 
 ``quick=True`` uses the registry's quick settings (the verification tests' too)
-with the same tolerances: about 5 s plus numba's one-off compilation of the
-coupled step; the full settings take about 20 s. matplotlib is imported only
-while drawing; this module prints nothing.
+with the same tolerances: about 10 s against 20 s for the full settings on two
+cores, plus numba's one-off compilation of the coupled step. matplotlib is
+imported only while drawing; this module prints nothing.
 """
 from __future__ import annotations
 
