@@ -9,9 +9,11 @@ verification tests assert on the same values.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Mapping, Union
+
+import numpy as np
 
 __all__ = ["CaseResult", "Detail", "FigureData", "StudyResult", "Table", "format_number", "judge"]
 
@@ -101,9 +103,28 @@ class CaseResult:
 
 @dataclass(frozen=True)
 class FigureData:
-    """The data of one figure; subclasses add the arrays. ``file`` is the PNG's name in the output directory."""
+    """The data of one figure; subclasses add the arrays. ``file`` is the PNG's name in the output directory.
+
+    Arrays (alone or in tuples) are stored as read-only copies: the data is frozen like the dataclass.
+    """
 
     file: str
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, np.ndarray):
+                object.__setattr__(self, f.name, _frozen(value))
+            elif isinstance(value, tuple) and any(isinstance(item, np.ndarray) for item in value):
+                object.__setattr__(self, f.name, tuple(_frozen(item) for item in value))
+
+
+def _frozen(value: object) -> object:
+    if not isinstance(value, np.ndarray):
+        return value
+    copy = value.copy()
+    copy.flags.writeable = False
+    return copy
 
 
 @dataclass(frozen=True)

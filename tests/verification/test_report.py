@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 
 from cosim.validation import ValidationReport, write_report
@@ -73,3 +74,12 @@ def test_summary_lines_end_with_the_total(report: ValidationReport) -> None:
     lines = report.summary_lines()
     assert len(lines) == len(report.cases) + 1
     assert lines[-1].startswith(f"{len(report.cases)} of {len(report.cases)} cases passed")
+
+
+def test_figure_data_is_frozen(all_computed) -> None:
+    # The studies return values, not views into live state: every array of every figure is read-only.
+    for result in all_computed:
+        for figure in result.figures:
+            for name, value in vars(figure).items():
+                arrays = value if isinstance(value, tuple) else (value,)
+                assert not any(isinstance(a, np.ndarray) and a.flags.writeable for a in arrays), (figure.file, name)
