@@ -9,7 +9,7 @@ from .text import EXIT_RUN_FAILED, print_lines
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from cosim.validation.cases import run_validation
+    from cosim.validation import run_validation
 
     def progress(done: int, total: int, label: str) -> None:
         print(f"[{done}/{total}] {label}", file=sys.stderr, flush=True)

@@ -11,7 +11,8 @@ import pytest
 
 from cosim.core.bridge import PointLoad
 from cosim.core.quasistatic import daf, influence, influence_vectors, quasi_static
-from cosim.core.simulation import Sensor, SolverSettings, simulate
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SolverSettings, simulate
 from cosim.testing import bridge as bridge_table
 from cosim.testing import moving_force, scenario, sensor
 

@@ -862,7 +862,8 @@ def test_output_defaults_log_path_and_rate(tmp_path: Path) -> None:
 
 
 def test_sensors_core_and_solver_settings() -> None:
-    from cosim.core.simulation import Sensor, SolverSettings
+    from cosim.core.sensors import Sensor
+    from cosim.core.simulation import SolverSettings
 
     scenario = parse_scenario(CONSTANTS_TEXT + '[solver]\ndt = 0.01\nscheme = "hht"\nhht_alpha = -0.1\ngravity = 9.8\n')
     assert scenario.sensors_core() == [Sensor(name="mid", x=5.0, y=-3.0, quantity="displacement")]

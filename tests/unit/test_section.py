@@ -5,8 +5,6 @@ Every reference value names its source. Tolerances are relative unless named
 """
 from __future__ import annotations
 
-import math
-
 import pytest
 
 from cosim.core import section
@@ -18,6 +16,7 @@ from cosim.core.section import (
     thin_walled_properties,
 )
 from cosim.errors import ConfigError, ModelError
+from cosim.validation.references import rectangle_torsion_constant
 
 # Exact integrals of a polygon: only round-off and the FE quadrature remain.
 EXACT_REL = 1e-6
@@ -71,16 +70,6 @@ def channel(b: float, h: float, t_f: float, t_w: float) -> list[Plate]:
     ]
 
 
-def rect_torsion_constant(long: float, short: float, terms: int = 50) -> float:
-    """St Venant J of a solid rectangle.
-
-    Timoshenko & Goodier, Theory of Elasticity (3rd ed.), sec. 109:
-    J = (s^3 l / 3) [1 - (192/pi^5)(s/l) sum_{n odd} tanh(n pi l / (2 s)) / n^5].
-    """
-    series = sum(math.tanh(n * math.pi * long / (2 * short)) / n**5 for n in range(1, 2 * terms, 2))
-    return short**3 * long / 3 * (1 - 192 / math.pi**5 * short / long * series)
-
-
 # --- solid rectangle --------------------------------------------------------
 
 def test_solid_rectangle_matches_elasticity() -> None:
@@ -92,8 +81,9 @@ def test_solid_rectangle_matches_elasticity() -> None:
     assert sec.I_z == pytest.approx(depth * width**3 / 12, rel=EXACT_REL)
     assert sec.I_yz == pytest.approx(0.0, abs=EXACT_REL * sec.I_y)
     assert sec.deck_y == pytest.approx((-width / 2, width / 2))
-    # Timoshenko & Goodier series (beta(2) = 0.229 in Roark's table).
-    assert sec.J == pytest.approx(rect_torsion_constant(depth, width), rel=RECT_J_REL)
+    # Timoshenko & Goodier series (beta(2) = 0.229 in Roark's table); its other aspect ratios:
+    # tests/verification/test_references.py.
+    assert sec.J == pytest.approx(rectangle_torsion_constant(width, depth), rel=RECT_J_REL)
     # Cowper (1966), J. Appl. Mech. 33, rectangle: k = 10(1+nu)/(12+11nu).
     assert sec.k_z == pytest.approx(10 * 1.2 / (12 + 11 * 0.2), rel=RECT_K_COWPER_REL)
 

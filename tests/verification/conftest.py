@@ -1,25 +1,31 @@
-"""Fixtures for the verification tests: the paper's validation case (shared/cases/paper-double-tee.md)."""
+"""Fixtures for the verification tests: the registered validation studies, each computed once per session.
+
+``cosim validate --quick`` and these tests run the same studies
+(:data:`cosim.validation.STUDIES`) at the same quick settings.
+"""
 from __future__ import annotations
+
+from typing import Callable
 
 import pytest
 
-from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
-from cosim.run.scenario import load_scenario
-from cosim.validation.cases import PAPER_LANE_Y, PAPER_QC1, PAPER_QC2, PAPER_QC2_ENTRY, PAPER_SPEED
+from cosim.validation import STUDIES, StudyResult, study
 
 
 @pytest.fixture(scope="session")
-def paper_bridge():
-    # The bundled scenario is the case file's bridge: 40 elements, rigid ends, Rayleigh 2 % at vertical-1/torsion-1.
-    return load_scenario("paper-double-tee").build_bridge()
+def computed() -> Callable[[str], StudyResult]:
+    """``computed(name)``: the registered study ``name`` at its quick settings, computed on first use."""
+    cache: dict[str, StudyResult] = {}
+
+    def get(name: str) -> StudyResult:
+        if name not in cache:
+            cache[name] = study(name).run(quick=True)
+        return cache[name]
+
+    return get
 
 
 @pytest.fixture(scope="session")
-def paper_traffic():
-    return ScriptedTraffic(
-        (
-            ScriptedVehicle("QC-1", PAPER_QC1, PAPER_LANE_Y, PAPER_SPEED, 0.0),
-            ScriptedVehicle("QC-2", PAPER_QC2, PAPER_LANE_Y, PAPER_SPEED, PAPER_QC2_ENTRY),
-        ),
-        40.0,
-    )
+def all_computed(computed: Callable[[str], StudyResult]) -> list[StudyResult]:
+    """Every registered study, in report order."""
+    return [computed(s.name) for s in STUDIES]
