@@ -34,6 +34,8 @@ from .vehicles import quarter_car, tyre_quarter_car
 from .vehicles.base import MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR
 
 DIRECT, MODAL = 0, 1
+#: A contact point closer than this share of the deck length to a node is on the node (round-off of x).
+NODE_SNAP = 1e-12
 
 #: What the loop needs of a basis (arrays a basis does not use are empty).
 #: kind: DIRECT | MODAL; n: unknowns.
@@ -110,10 +112,12 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 
 # ------------------------------------------------------------- contact rows
 @compiled
-def contact_rows(x, y, deck, elems, vals):  # noqa: ANN001, ANN201
+def contact_rows(x, y, v, deck, elems, vals):  # noqa: ANN001, ANN201
     """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
 
-    docs/theory.md §5.1.
+    docs/theory.md §5.1. At a node, w_xx of the cubic elements jumps: a contact
+    point exactly on a node takes the element ahead of it in its direction of
+    travel (speed ``v``), so that mirrored crossings see mirrored rows.
     """
     q = x.shape[0]
     nodes_x, cw, ct = deck.nodes_x, deck.cw, deck.ct
@@ -129,6 +133,11 @@ def contact_rows(x, y, deck, elems, vals):  # noqa: ANN001, ANN201
             continue
         e = np.searchsorted(nodes_x, xi_abs, side="right") - 1
         e = min(max(e, 0), n_el - 1)
+        snap = NODE_SNAP * deck.length
+        if v[i] < 0.0 and e > 0 and xi_abs - nodes_x[e] <= snap:
+            e -= 1  # at the node starting element e: the element ahead is e - 1
+        elif v[i] >= 0.0 and e < n_el - 1 and nodes_x[e + 1] - xi_abs <= snap:
+            e += 1  # at the node ending element e: the element ahead is e + 1
         L = nodes_x[e + 1] - nodes_x[e]
         xi = min(max((xi_abs - nodes_x[e]) / L, 0.0), 1.0)
         lever = y[i] - deck.y_s
@@ -428,7 +437,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
         internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
-        contact_rows(kin.x[step], kin.y, deck, elems, vals)
+        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals)
         project_contacts(basis, deck, elems, vals, idx, rv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
