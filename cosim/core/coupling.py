@@ -44,8 +44,9 @@ from .element import DECK_POINT_DOFS, NODE_DOFS
 from .roughness import RoadProfile, smooth_road
 from .schemes import Scheme
 from .sensors import TIME_DERIVATIVE, Sensor, check_sensor_on, sensor_row
-from .traffic import TrafficBlock, TrafficFrame
+from .traffic import AXLE_SEPARATOR, TrafficBlock, TrafficFrame, vehicle_of
 from .vehicles import MODELS, PARAM_ROWS, STATE_ROWS, VehicleModel
+from .vehicles.base import LINEAR
 
 #: Lateral tolerance of "on the deck" for a wheel path, relative to the deck width.
 _Y_TOL = 1e-9
@@ -77,7 +78,7 @@ class BlockReport:
 
 def _fleet_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray,
                                                                                           np.ndarray]:
-    """Compiled kind, parameters (PARAM_ROWS, q) and total mass (q,) of the vehicles."""
+    """Compiled kind, parameters (PARAM_ROWS, q) and total mass (q,) of the vehicles (contact columns)."""
     q = len(models)
     kind = np.empty(q, dtype=np.int64)
     params = np.zeros((PARAM_ROWS, q))
@@ -86,11 +87,49 @@ def _fleet_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) ->
         if type(m) not in MODELS.values():
             raise ConfigError(f"vehicle {ids[j]}: unknown vehicle model {type(m).__name__} "
                               f"(expected one of: {', '.join(MODELS)})")
-        kind[j] = m.KIND
+        kind[j] = m.kernel_kind
         packed = m.pack()
         params[: len(packed), j] = packed
         mass[j] = m.total_mass
     return kind, params, mass
+
+
+@dataclass
+class _LinearVehicle:
+    """A linear vehicle's matrices (for this run's gravity) and its state between blocks."""
+
+    system: dict[str, np.ndarray]
+    state: np.ndarray  # z, z', z'', previous elastic forces (4 nz)
+    flying: np.ndarray  # per contact
+
+
+def _linear_groups(ids: tuple[str, ...], models: tuple[VehicleModel, ...], kind: np.ndarray) -> list[list[int]]:
+    """Columns of each linear vehicle: consecutive columns of one vehicle ("v#0", "v#1", ...) sharing a model."""
+    groups: list[list[int]] = []
+    j = 0
+    while j < len(ids):
+        if kind[j] != LINEAR:
+            j += 1
+            continue
+        model = models[j]
+        count = getattr(model, "contacts", 1)
+        cols = list(range(j, j + count))
+        owner = vehicle_of(ids[j])
+        expected = [f"{owner}{AXLE_SEPARATOR}{k}" for k in range(count)] if count > 1 else [ids[j]]
+        if len(ids) < j + count or [ids[c] for c in cols] != expected or \
+                any(models[c] is not model for c in cols):
+            raise ConfigError(f"vehicle {owner}: its {count} axles must come together as {', '.join(expected)} "
+                              "(one contact column per axle, in order, with the same model)")
+        groups.append(cols)
+        j += count
+    return groups
+
+
+def _no_groups(q: int) -> kernels.GroupArrays:
+    """No linear vehicles among q contact columns."""
+    empty_i = np.zeros(0, dtype=np.int64)
+    return kernels.GroupArrays(empty_i, empty_i, empty_i, empty_i, np.zeros(0), empty_i, np.zeros(0), empty_i,
+                               np.zeros(0), np.full(q, -1, dtype=np.int64), np.zeros(q, dtype=np.bool_), False)
 
 
 class CoupledSystem:
@@ -151,7 +190,10 @@ class CoupledSystem:
         self.ids: tuple[str, ...] = ()
         self._kind = np.zeros(0, dtype=np.int64)
         self._params = np.zeros((PARAM_ROWS, 0))
-        self._mass = np.zeros(0)
+        self._weight = np.zeros(0)
+        self._linear: dict[str, _LinearVehicle] = {}  # by vehicle id
+        self._group_cols: list[list[int]] = []
+        self._groups = _no_groups(0)
         self._vstate = np.zeros((STATE_ROWS, 0))
         self._lifted = np.zeros(0, dtype=bool)
         self.sensors = tuple(sensors)
@@ -219,22 +261,103 @@ class CoupledSystem:
         if block.ids == self.ids:
             return
         self._check_paths(block)
+        self._store_linear_states()
         old = {vid: i for i, vid in enumerate(self.ids)}
         q = len(block.ids)
         vstate = np.zeros((STATE_ROWS, q))
         lifted = np.zeros(q, dtype=bool)
         kind, params, mass = _fleet_parameters(block.models, block.ids)
+        weight = mass * self.gravity
         for j, vid in enumerate(block.ids):
             if vid in old:
                 vstate[:, j] = self._vstate[:, old[vid]]
                 lifted[j] = self._lifted[old[vid]]
             else:
-                x0, y0 = float(block.x[0, j]), float(block.y[j])
-                r0, _ = self.road.evaluate(np.array([y0]), np.array([x0]))
-                level = float(r0[0]) + self._deck_w(x0, y0)
+                level = self._level(float(block.x[0, j]), float(block.y[j]))
                 vstate[0, j] = vstate[3, j] = level
-        self.ids, self._kind, self._params, self._mass = block.ids, kind, params, mass
+        group_cols = _linear_groups(block.ids, block.models, kind)
+        present = set()
+        for cols in group_cols:
+            owner = vehicle_of(block.ids[cols[0]]) if len(cols) > 1 else block.ids[cols[0]]
+            present.add(owner)
+            model = block.models[cols[0]]
+            if owner not in self._linear:
+                self._linear[owner] = self._new_linear(model, block, cols)
+            system = self._linear[owner].system
+            for k, c in enumerate(cols):
+                params[:3, c] = system["k_t"][k], system["c_t"][k], 1.0 if getattr(model, "unilateral", False) else 0.0
+                weight[c] = system["loads"][k]
+        self._linear = {k: v for k, v in self._linear.items() if k in present}
+        self.ids, self._kind, self._params, self._weight = block.ids, kind, params, weight
         self._vstate, self._lifted = vstate, lifted
+        self._group_cols = group_cols
+        self._groups = self._pack_groups(block, group_cols)
+
+    def _level(self, x: float, y: float) -> float:
+        """Road plus deck at (x, y): where a newcomer's wheel stands (static equilibrium), m."""
+        r0, _ = self.road.evaluate(np.array([y]), np.array([x]))
+        return float(r0[0]) + self._deck_w(x, y)
+
+    def _new_linear(self, model: VehicleModel, block: TrafficBlock, cols: list[int]) -> _LinearVehicle:
+        """A linear vehicle arriving: its matrices and its static equilibrium on the road under its wheels."""
+        system = model.linear_system(self.gravity)  # type: ignore[union-attr]  # LINEAR models have one
+        levels = np.array([self._level(float(block.x[0, c]), float(block.y[c])) for c in cols])
+        b, k_t = system["b"], system["k_t"]
+        k_total = system["kv"] + (b.T * k_t) @ b
+        z0 = np.linalg.solve(k_total, b.T @ (k_t * levels))
+        nz = len(z0)
+        state = np.zeros(4 * nz)
+        state[:nz] = z0
+        state[3 * nz:] = system["kv"] @ z0 + b.T @ (k_t * (b @ z0 - levels))  # elastic forces at rest: zero sum
+        return _LinearVehicle(system, state, np.zeros(len(cols), dtype=bool))
+
+    def _pack_groups(self, block: TrafficBlock, group_cols: list[list[int]]) -> kernels.GroupArrays:
+        """The linear vehicles of this fleet as the flat arrays the compiled loop reads."""
+        if not group_cols:
+            return _no_groups(len(block.ids))
+        first, ncont, nzs, moff, soff, aoff = [], [], [], [], [], []
+        mats, state = [], []
+        col = np.full(len(block.ids), -1, dtype=np.int64)
+        flying = np.zeros(len(block.ids), dtype=np.bool_)
+        m_at = s_at = a_at = 0
+        unilateral = False
+        for g, cols in enumerate(group_cols):
+            owner = vehicle_of(block.ids[cols[0]]) if len(cols) > 1 else block.ids[cols[0]]
+            vehicle = self._linear[owner]
+            sys_ = vehicle.system
+            nz, nc = sys_["mv"].shape[0], len(cols)
+            first.append(cols[0])
+            ncont.append(nc)
+            nzs.append(nz)
+            moff.append(m_at)
+            soff.append(s_at)
+            aoff.append(a_at)
+            part = np.concatenate([sys_["mv"].ravel(), sys_["cv"].ravel(), sys_["kv"].ravel(),
+                                   sys_["b"].ravel(), sys_["obs"].ravel()])
+            mats.append(part)
+            state.append(vehicle.state)
+            m_at += len(part)
+            s_at += len(vehicle.state)
+            a_at += nz + nz * nc + nc + nc * nc
+            col[cols] = g
+            flying[cols] = vehicle.flying
+            unilateral = unilateral or bool(getattr(block.models[cols[0]], "unilateral", False))
+        return kernels.GroupArrays(
+            np.array(first, dtype=np.int64), np.array(ncont, dtype=np.int64), np.array(nzs, dtype=np.int64),
+            np.array(moff, dtype=np.int64), np.concatenate(mats), np.array(soff, dtype=np.int64),
+            np.concatenate(state), np.array(aoff, dtype=np.int64), np.zeros(a_at), col, flying, unilateral)
+
+    def _store_linear_states(self) -> None:
+        """Copy the linear vehicles' states out of the flat arrays before the fleet changes."""
+        groups = self._groups
+        for g, cols in enumerate(self._group_cols):
+            owner = vehicle_of(self.ids[cols[0]]) if len(cols) > 1 else self.ids[cols[0]]
+            vehicle = self._linear.get(owner)
+            if vehicle is None:
+                continue
+            s0 = int(groups.soff[g])
+            vehicle.state[:] = groups.state[s0:s0 + len(vehicle.state)]
+            vehicle.flying[:] = groups.flying[cols]
 
     # ------------------------------------------------------------------ steps
     def advance(self, block: TrafficBlock) -> BlockReport:
@@ -251,12 +374,13 @@ class CoupledSystem:
         out = kernels.BlockOutputs(
             np.zeros((K, len(self.sensors))), np.zeros((K, q)), np.zeros((K, q)), np.zeros((K, q)),
             np.zeros((K, q), dtype=np.bool_), np.zeros((K, q), dtype=np.bool_), self._counters)
-        fleet = kernels.Fleet(self._kind, self._params, self._mass * self.gravity, self._vstate, self._lifted)
+        fleet = kernels.Fleet(self._kind, self._params, self._weight, self._vstate, self._lifted)
         kin = kernels.Kinematics(
             np.ascontiguousarray(block.x, dtype=float), np.ascontiguousarray(block.v, dtype=float),
             np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x))
         self._counters[3] = 0
-        kernels.advance_block(self._basis, self._deck, self._scheme, self._state, fleet, kin, self._sensor_rows, out)
+        kernels.advance_block(self._basis, self._deck, self._scheme, self._state, fleet, kin, self._sensor_rows, out,
+                              self._groups)
         self.basis.n_solves = int(self._counters[2])
         if self._counters[3]:
             k = int(self._counters[3])

@@ -30,8 +30,8 @@ import numpy as np
 
 from .jit import compiled
 from .traffic import on_deck
-from .vehicles import quarter_car, tyre_quarter_car
-from .vehicles.base import MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR
+from .vehicles import linear, quarter_car, tyre_quarter_car
+from .vehicles.base import LINEAR, MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR
 
 DIRECT, MODAL = 0, 1
 #: A contact point closer than this share of the deck length to a node is on the node (round-off of x).
@@ -60,6 +60,16 @@ Fleet = namedtuple("Fleet", ["kind", "params", "weight", "vstate", "lifted"])
 Kinematics = namedtuple("Kinematics", ["x", "v", "a", "y", "r", "r_x"])
 #: Sensor rows in basis coordinates (s, nnz) and the time derivative each reads (0 d, 1 d', 2 d'').
 SensorRows = namedtuple("SensorRows", ["idx", "vals", "order"])
+#: Linear vehicles on tyres (cosim.core.vehicles.linear), each a group of consecutive contact columns.
+#: Per vehicle g: first column, contacts, DOFs; offsets into ``mats`` (Mv, Cv, Kv, contact rows b, body
+#: observation rows, flattened), ``state`` (z, z', z'', previous elastic forces) and ``aux`` (step scratch).
+#: Per column: ``col`` its vehicle (-1: a one-contact model), ``flying`` (unilateral contact off the deck).
+#: ``unilateral``: some contact may leave the deck (the step is then solved until the contact states agree).
+GroupArrays = namedtuple("GroupArrays", [
+    "first", "ncont", "nz", "moff", "mats", "soff", "state", "aoff", "aux", "col", "flying", "unilateral",
+])
+#: How often a step is solved again at most when unilateral contacts change state within it.
+MAX_CONTACT_SWITCHES = 8
 #: What a block records: sensors (K, s); contact force, body u and u'' (K, q); on the deck and lifted off
 #: (K, q); counters: lift-off events, lift-off vehicle-steps, solves, the step that diverged (0: none).
 BlockOutputs = namedtuple("BlockOutputs", ["sensors", "contact", "body_u", "body_a", "on", "lifted", "counters"])
@@ -229,7 +239,30 @@ def solve(basis, b, x, counters):  # noqa: ANN001, ANN201
 
 
 @compiled
-def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001, ANN201
+def _mix_groups(groups, S, pz):  # noqa: ANN001, ANN201
+    """Rows of a multi-contact vehicle: S <- I + H S~ and pz <- H pz~ with its coupling matrix H."""
+    q = S.shape[0]
+    for g in range(groups.first.shape[0]):
+        first, nc = groups.first[g], groups.ncont[g]
+        a0 = groups.aoff[g]
+        nz = groups.nz[g]
+        h0 = a0 + nz + nz * nc + nc
+        rows = S[first:first + nc, :].copy()
+        pzs = pz[first:first + nc].copy()
+        for k in range(nc):
+            for c in range(q):
+                s = 1.0 if first + k == c else 0.0
+                for m in range(nc):
+                    s += groups.aux[h0 + k * nc + m] * rows[m, c]
+                S[first + k, c] = s
+            s = 0.0
+            for m in range(nc):
+                s += groups.aux[h0 + k * nc + m] * pzs[m]
+            pz[first + k] = s
+
+
+@compiled
+def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups):  # noqa: ANN001, ANN201
     """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
 
     Capacitance matrix ``S = I + P A^-1 U^T``: on the direct basis from the
@@ -247,7 +280,7 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001
                     s += p[i, kk] * z_b[j]
             pz[i] = s
             for jv in range(q):
-                s = 1.0 if i == jv else 0.0
+                s = 1.0 if i == jv and groups.col[i] < 0 else 0.0
                 for kk in range(nnz):
                     r_ = idx[i, kk]
                     if r_ < 0:
@@ -259,6 +292,7 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001
                             acc_ += ainv[r_, c_] * rv[jv, 0, ll]
                     s += p[i, kk] * acc_
                 S[i, jv] = s
+        _mix_groups(groups, S, pz)
         sol = np.linalg.solve(S, pz)
         for j in range(us.shape[0]):
             us[j] = 0.0
@@ -280,10 +314,11 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001
                 s += p[i, j] * z_b[j]
             pz[i] = s
             for k in range(q):
-                s = 1.0 if i == k else 0.0
+                s = 1.0 if i == k and groups.col[i] < 0 else 0.0
                 for j in range(m):
                     s += p[i, j] * (a_inv[j] * rv[k, 0, j])
                 S[i, k] = s
+        _mix_groups(groups, S, pz)
         sol = np.linalg.solve(S, pz)
         for j in range(m):
             c = 0.0
@@ -294,13 +329,18 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters):  # noqa: ANN001
 
 # --------------------------------------------------------- vehicle physics
 @compiled
-def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux):  # noqa: ANN001, ANN201
+def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups):  # noqa: ANN001, ANN201
     """Every vehicle's predictors and deck-force coefficients: ``E_i = e0_i - (c0 n0 + c1 n1 + c2 n2)_i . a``."""
     dt, beta, gamma, alpha = scheme.dt, scheme.beta, scheme.gamma, scheme.alpha
     ca = 1.0 + alpha
     b2, g1 = beta * dt * dt, gamma * dt
     vstate = fleet.vstate
     for i in range(fleet.kind.shape[0]):
+        kind = fleet.kind[i]
+        if kind == LINEAR:  # the whole vehicle at its first column (its later columns are filled then)
+            if i == groups.first[groups.col[i]]:
+                linear.group_coefficients(groups.col[i], groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2)
+            continue
         pred[0, i] = vstate[0, i] + dt * vstate[1, i] + (0.5 - beta) * dt * dt * vstate[2, i]
         pred[1, i] = vstate[1, i] + (1.0 - gamma) * dt * vstate[2, i]
         pred[2, i] = vstate[3, i] + dt * vstate[4, i] + (0.5 - beta) * dt * dt * vstate[5, i]
@@ -309,7 +349,6 @@ def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, a
         c0[i] = 0.0
         c1[i] = 0.0
         c2[i] = 0.0
-        kind = fleet.kind[i]
         v, a, r, r_x = kin.v[step, i], kin.a[step, i], kin.r[step, i], kin.r_x[step, i]
         if kind == QUARTER_CAR:
             quarter_car.coefficients(i, fleet.params, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha,
@@ -320,7 +359,7 @@ def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, a
 
 
 @compiled
-def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted):  # noqa: ANN001, ANN201
+def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups):  # noqa: ANN001, ANN201
     """Advance the vehicles once the bridge acceleration is known; fills contact forces (N, compression
     positive) and the non-inertial deck forces (the HHT F_{n+1})."""
     dt, beta, gamma, alpha = scheme.dt, scheme.beta, scheme.gamma, scheme.alpha
@@ -329,6 +368,11 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted)
     vstate = fleet.vstate
     for i in range(fleet.kind.shape[0]):
         kind = fleet.kind[i]
+        if kind == LINEAR:  # the whole vehicle at its first column
+            g = groups.col[i]
+            if i == groups.first[g]:
+                linear.group_update(g, groups, fleet, kin, step, dots, scheme, vstate, contact, weighted)
+            continue
         v, a = kin.v[step, i], kin.a[step, i]
         n0a, n1a, n2a = dots[5, i], dots[6, i], dots[7, i]
         acc_b = 0.0
@@ -377,7 +421,7 @@ def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN2
 
 
 @compiled
-def _record(step, elems, contact, fleet, out):  # noqa: ANN001, ANN201
+def _record(step, elems, contact, fleet, groups, out):  # noqa: ANN001, ANN201
     """The step's vehicle outputs, and lift-off: the one place where it is detected and counted (theory §5.7)."""
     counters = out.counters
     for i in range(elems.shape[0]):
@@ -386,7 +430,7 @@ def _record(step, elems, contact, fleet, out):  # noqa: ANN001, ANN201
         out.contact[step, i] = contact[i] if on else 0.0
         out.body_u[step, i] = fleet.vstate[0, i]
         out.body_a[step, i] = fleet.vstate[2, i]
-        now = on and contact[i] < 0.0
+        now = on and (contact[i] < 0.0 or groups.flying[i])
         out.lifted[step, i] = now
         if now:
             counters[1] += 1
@@ -396,7 +440,7 @@ def _record(step, elems, contact, fleet, out):  # noqa: ANN001, ANN201
 
 
 @compiled(nogil=True)
-def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa: ANN001, ANN201
+def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):  # noqa: ANN001, ANN201
     """Advance K = kin.x.shape[0] steps; state, fleet and out are updated in place (docs/theory.md §6).
 
     Stops early when the bridge acceleration turns non-finite (``out.counters[3]`` = that step + 1).
@@ -432,6 +476,11 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
     z_b = np.empty(n)
     elems = np.empty(q, dtype=np.int64)
     vals = np.empty((q, 3, deck.cw.shape[1]))
+    rhs_bridge = np.empty(n)
+    tau0 = np.empty(q)
+    tau1 = np.empty(q)
+    w_end = np.empty(q)
+    wd_end = np.empty(q)
     for step in range(kin.x.shape[0]):
         for j in range(n):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
@@ -451,16 +500,42 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
                     s3 += rv[i, 2, kk] * d_star[j]
                     s4 += rv[i, 1, kk] * v_star[j]
             dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = s0, s1, s2, s3, s4
-        vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux)
-        for i in range(q):
-            for kk in range(nnz):
-                j = idx[i, kk]
-                p[i, kk] = c0[i] * rv[i, 0, kk] + c1[i] * rv[i, 1, kk] + c2[i] * rv[i, 2, kk]
-                if j >= 0:
-                    rhs[j] += rv[i, 0, kk] * e0[i]
-        solve(basis, rhs, z_b, out.counters)
-        if q > 0:
-            woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters)
+        if groups.unilateral:
+            for j in range(n):
+                rhs_bridge[j] = rhs[j]
+        for attempt in range(MAX_CONTACT_SWITCHES + 1):
+            if attempt > 0:
+                for j in range(n):
+                    rhs[j] = rhs_bridge[j]
+            vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups)
+            for i in range(q):
+                for kk in range(nnz):
+                    j = idx[i, kk]
+                    p[i, kk] = c0[i] * rv[i, 0, kk] + c1[i] * rv[i, 1, kk] + c2[i] * rv[i, 2, kk]
+                    if j >= 0:
+                        rhs[j] += rv[i, 0, kk] * e0[i]
+            solve(basis, rhs, z_b, out.counters)
+            if q > 0:
+                woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters, groups)
+            if not groups.unilateral or attempt == MAX_CONTACT_SWITCHES:
+                break
+            # Unilateral contact: does the trial step agree with the contact states it assumed?
+            for i in range(q):
+                s0 = s1 = 0.0
+                for kk in range(nnz):
+                    j = idx[i, kk]
+                    if j >= 0:
+                        s0 += rv[i, 0, kk] * z_b[j]
+                        s1 += rv[i, 1, kk] * z_b[j]
+                tau0[i], tau1[i] = s0, s1
+                w_end[i] = dots[0, i] + b2 * s0
+                wd_end[i] = dots[2, i] + g1 * s0 + kin.v[step, i] * (dots[1, i] + b2 * s1)
+            changed = False
+            for g in range(groups.first.shape[0]):
+                if linear.group_check(g, groups, fleet, kin, step, tau0, tau1, w_end, wd_end, scheme):
+                    changed = True
+            if not changed:
+                break
         if basis.kind == MODAL:
             out.counters[2] += 1  # one (diagonal) solve per step, with or without vehicles
         if not _newmark_update(d, v, a, d_star, v_star, z_b, b2, g1):
@@ -480,7 +555,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
                     s5 += rv[i, 1, kk] * d[j]
             dots[5, i], dots[6, i], dots[7, i], dots[8, i] = s0, s1, s2, s3
             dots[9, i] = s4 + kin.v[step, i] * s5
-        vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted)
+        vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups)
         if alpha != 0.0:
             for j in range(n):
                 force[j] = 0.0
@@ -489,7 +564,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out):  # noqa
                     j = idx[i, kk]
                     if j >= 0:
                         force[j] += rv[i, 0, kk] * weighted[i]
-        _record(step, elems, contact, fleet, out)
+        _record(step, elems, contact, fleet, groups, out)
         for s_ in range(sensors.idx.shape[0]):
             order = sensors.order[s_]
             src = d if order == 0 else (v if order == 1 else a)

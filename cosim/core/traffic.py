@@ -176,8 +176,15 @@ class ScriptedTraffic:
         object.__setattr__(self, "_ids", frozenset(ids))
 
     def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
-        """The vehicles on the deck at any of ``times`` (s), with their kinematics at each."""
+        """The vehicles on the deck at any of ``times`` (s), with their kinematics at each.
+
+        A vehicle with several axles (a :class:`~cosim.core.vehicles.HalfCar`) is
+        one column per axle, ``<id>#<k>``, the axles following its front axle; it is
+        in the block, all axles together, while any of them is on the deck.
+        """
         times = np.asarray(times, dtype=float)
+        if any(veh.model.contacts > 1 for veh in self.vehicles):
+            return self._axle_block(times)
         n = len(self.vehicles)
         s = np.empty((len(times), n))
         v = np.empty_like(s)
@@ -199,6 +206,33 @@ class ScriptedTraffic:
             y=np.array([self.vehicles[j].y for j in present], dtype=float),
         )
 
+    def _axle_block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
+        """:meth:`block` with a column per axle (multi-axle models)."""
+        ids: list[str] = []
+        models: list[VehicleModel] = []
+        xs, vs, accs, ys = [], [], [], []
+        for veh in self.vehicles:
+            dist, speed, acc = veh.distance(times - veh.entry_time)
+            entered = times >= veh.entry_time
+            offsets = veh.model.contact_offsets
+            cols = []
+            for off in offsets:  # axle k is `off` behind the front axle
+                s = np.where(entered, dist - off, np.minimum(dist - off, -1e-9))
+                cols.append(s if veh.direction > 0 else self.length - s)
+            x_axles = np.stack(cols, axis=1)
+            if not on_deck(x_axles, self.length).any():
+                continue
+            names = [f"{veh.id}{AXLE_SEPARATOR}{k}" for k in range(len(offsets))] if len(offsets) > 1 else [veh.id]
+            ids += names
+            models += [veh.model] * len(offsets)
+            xs.append(x_axles)
+            vs.append(np.repeat((veh.direction * speed)[:, None], len(offsets), axis=1))
+            accs.append(np.repeat((veh.direction * acc)[:, None], len(offsets), axis=1))
+            ys += [veh.y] * len(offsets)
+        k = len(times)
+        stack = (lambda parts: np.concatenate(parts, axis=1)) if xs else (lambda parts: np.zeros((k, 0)))
+        return TrafficBlock(tuple(ids), tuple(models), stack(xs), stack(vs), stack(accs), np.array(ys, dtype=float))
+
     def frame(self, t: float) -> TrafficFrame:
         """The vehicles on the deck at time ``t`` (s)."""
         b = self.block(np.array([t]))
@@ -210,17 +244,18 @@ class ScriptedTraffic:
         )
 
     def end_time(self) -> float:
-        """Time when the last vehicle leaves the deck, s (inf if one stops on it)."""
+        """Time when the last vehicle (its last axle) leaves the deck, s (inf if one stops on it)."""
         latest = 0.0
         for veh in self.vehicles:
+            travel = self.length + max(veh.model.contact_offsets)  # the front axle's way until the last leaves
             if not veh.profile:
-                latest = max(latest, veh.entry_time + self.length / veh.speed)
+                latest = max(latest, veh.entry_time + travel / veh.speed)
                 continue
             if veh.profile[-1][1] <= 0:
                 return float("inf")
             t_last, _ = veh.profile[-1]
             s_last, _, _ = veh.distance(t_last)
-            remaining = max(self.length - float(s_last), 0.0)
+            remaining = max(travel - float(s_last), 0.0)
             latest = max(latest, veh.entry_time + t_last + remaining / veh.profile[-1][1])
         return latest
 

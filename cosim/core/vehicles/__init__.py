@@ -9,7 +9,10 @@ wheel would lift off: it is counted and reported; the contact is kept
 
 - :class:`MovingForce`: ``P = m g``, no inertia (the classical benchmark).
 - :class:`QuarterCar`: the paper's model (rigid wheel-deck contact).
-- :class:`TyreQuarterCar`: the wheel on a tyre spring and damper.
+- :class:`TyreQuarterCar`: the wheel on a tyre spring and damper (bilateral, or
+  unilateral: the tyre may leave the deck and land again).
+- :class:`HalfCar`: a body that bounces and pitches on any number of axles
+  (:class:`Axle`), one contact point per axle (an axle group).
 
 Adding a model: a module here with the frozen dataclass (``kind`` name,
 ``KIND`` id from :mod:`.base`, ``pack()``, ``total_mass``) and its compiled
@@ -26,17 +29,20 @@ from typing import Any, Union
 from cosim.errors import ConfigError
 
 from .base import PARAM_ROWS, STATE_ROWS
+from .half_car import Axle, HalfCar
 from .moving_force import MovingForce
 from .quarter_car import QuarterCar
 from .tyre_quarter_car import TyreQuarterCar
 
-VehicleModel = Union[MovingForce, QuarterCar, TyreQuarterCar]
+VehicleModel = Union[MovingForce, QuarterCar, TyreQuarterCar, HalfCar]
 
 #: Every vehicle model by its name (the ``model`` key of scenarios and logs).
-MODELS: dict[str, type] = {cls.kind: cls for cls in (MovingForce, QuarterCar, TyreQuarterCar)}
+MODELS: dict[str, type] = {cls.kind: cls for cls in (MovingForce, QuarterCar, TyreQuarterCar, HalfCar)}
 MODEL_NAMES: tuple[str, ...] = tuple(MODELS)
 
 __all__ = [
+    "Axle",
+    "HalfCar",
     "MODELS",
     "MODEL_NAMES",
     "PARAM_ROWS",
@@ -51,8 +57,9 @@ __all__ = [
 
 
 def model_to_dict(model: VehicleModel) -> dict[str, float | str]:
-    """A plain description of a vehicle model (for logs): ``{"model": kind, <parameters>}``."""
-    return {"model": model.kind, **asdict(model)}
+    """A plain description of a vehicle model (for logs): ``{"model": kind, <parameters as numbers>}``."""
+    record = model.record() if hasattr(model, "record") else asdict(model)
+    return {"model": model.kind, **record}
 
 
 def model_from_dict(data: dict[str, Any]) -> VehicleModel:
@@ -65,6 +72,7 @@ def model_from_dict(data: dict[str, Any]) -> VehicleModel:
         if not isinstance(value, (int, float)) or isinstance(value, bool):
             raise ConfigError(f"vehicle model parameter `{key}` must be a number (got {value!r})")
     try:
-        return MODELS[kind](**params)
+        cls = MODELS[kind]
+        return cls.from_record(params) if hasattr(cls, "from_record") else cls(**params)
     except TypeError as exc:
         raise ConfigError(f"vehicle model {kind}: {exc}") from None

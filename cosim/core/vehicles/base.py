@@ -24,8 +24,10 @@ from cosim.errors import ConfigError
 STATE_ROWS = 8
 #: Rows of a vehicle's compiled parameters (the longest ``pack()``).
 PARAM_ROWS = 6
-#: The kind ids the compiled loop dispatches on, one per model (see ``cosim.core.vehicles.MODELS``).
-MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR = 0, 1, 2
+#: The kind ids the compiled loop dispatches on (see ``cosim.core.vehicles.MODELS``): the three one-contact
+#: models with their own compiled physics, and LINEAR: any linear vehicle on tyres, with one or more contacts
+#: and bilateral or unilateral contact (``cosim.core.vehicles.linear``).
+MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR, LINEAR = 0, 1, 2, 3
 
 
 def check_positive(owner: str, **values: float) -> None:

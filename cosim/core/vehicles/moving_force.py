@@ -22,6 +22,13 @@ class MovingForce:
     mass: float
     kind: ClassVar[str] = "moving-force"
     KIND: ClassVar[int] = MOVING_FORCE
+    contacts: ClassVar[int] = 1
+    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
+
+    @property
+    def kernel_kind(self) -> int:
+        """Compiled kind."""
+        return self.KIND
 
     def __post_init__(self) -> None:
         check_positive("moving force", mass=self.mass)

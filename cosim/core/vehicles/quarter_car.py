@@ -34,6 +34,13 @@ class QuarterCar:
     c_v: float
     kind: ClassVar[str] = "quarter-car"
     KIND: ClassVar[int] = QUARTER_CAR
+    contacts: ClassVar[int] = 1
+    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
+
+    @property
+    def kernel_kind(self) -> int:
+        """Compiled kind."""
+        return self.KIND
 
     def __post_init__(self) -> None:
         check_positive("quarter-car", m_v=self.m_v, k_v=self.k_v)

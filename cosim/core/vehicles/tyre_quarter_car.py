@@ -6,10 +6,15 @@ sets (body, wheel, suspension, tyre) apply directly.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
+
+import numpy as np
+
+from cosim.errors import ConfigError
 
 from ..jit import compiled
-from .base import TYRE_QUARTER_CAR, check_non_negative, check_positive
+from .base import LINEAR, TYRE_QUARTER_CAR, check_non_negative, check_positive
+from .half_car import tyre_quarter_car_system
 
 
 @dataclass(frozen=True)
@@ -20,6 +25,8 @@ class TyreQuarterCar:
         m_v: body mass, kg.  m_w: wheel mass, kg (> 0).
         k_v, c_v: suspension, N/m and N s/m.
         k_t, c_t: tyre, N/m and N s/m.
+        unilateral: the tyre may leave the deck (it carries no tension) and land again;
+            False keeps the paper's bilateral contact (a pulling tyre is counted as a lift-off).
     """
 
     m_v: float
@@ -28,12 +35,40 @@ class TyreQuarterCar:
     c_v: float
     k_t: float
     c_t: float = 0.0
+    unilateral: bool = False
     kind: ClassVar[str] = "tyre-quarter-car"
     KIND: ClassVar[int] = TYRE_QUARTER_CAR
+    contacts: ClassVar[int] = 1
+    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
 
     def __post_init__(self) -> None:
         check_positive("tyre quarter-car", m_v=self.m_v, m_w=self.m_w, k_v=self.k_v, k_t=self.k_t)
         check_non_negative("tyre quarter-car", c_v=self.c_v, c_t=self.c_t)
+        if not isinstance(self.unilateral, bool):
+            raise ConfigError(f"tyre quarter-car: `unilateral` must be true or false (got {self.unilateral!r})")
+
+    @property
+    def kernel_kind(self) -> int:
+        """Compiled kind: unilateral contact runs through the linear-vehicle path (the tyre may leave the deck)."""
+        return LINEAR if self.unilateral else TYRE_QUARTER_CAR
+
+    def record(self) -> dict[str, float]:
+        """The model as numbers only (for logs); ``unilateral`` appears only when set."""
+        out = {k: getattr(self, k) for k in ("m_v", "m_w", "k_v", "c_v", "k_t", "c_t")}
+        if self.unilateral:
+            out["unilateral"] = 1.0
+        return out
+
+    @classmethod
+    def from_record(cls, values: dict[str, Any]) -> TyreQuarterCar:
+        """The inverse of :meth:`record`."""
+        params = dict(values)
+        params["unilateral"] = bool(params.pop("unilateral", 0.0))
+        return cls(**params)
+
+    def linear_system(self, gravity: float) -> dict[str, np.ndarray]:
+        """The model as a linear vehicle [body, wheel] (used for unilateral contact)."""
+        return tyre_quarter_car_system(self.m_v, self.m_w, self.k_v, self.c_v, self.k_t, self.c_t, gravity)
 
     @property
     def total_mass(self) -> float:
