@@ -167,7 +167,16 @@ def _log_target(out: str | None, default: Path, force: bool) -> Path:
     return path
 
 
-_PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m"}
+_PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m",
+                    "m_b": "kg", "i_b": "kg m^2", "cg": "m"}
+
+
+def _parameter_text(key: str, value: Any) -> str:
+    if key == "axles":
+        return f"{len(value)} axles at {', '.join(fmt_g(a.distance) for a in value)} m"
+    if key == "pitch":
+        return "pitch" if value else "no pitch"
+    return f"{key} = {fmt_g(value)} {_PARAMETER_UNITS[key]}"
 
 
 def _traffic_line(scenario: Scenario) -> str:
@@ -190,7 +199,9 @@ def _vehicle_lines(scenario: Scenario) -> list[str]:
             speed = "profile " + " ".join(f"{fmt_g(t)}s:{fmt_g(vv)}" for t, vv in v.profile)
         else:
             speed = fmt_g(v.speed or 0.0)
-        params = ", ".join(f"{k} = {fmt_g(val)} {_PARAMETER_UNITS[k]}" for k, val in v.parameters.items())
+        params = ", ".join(_parameter_text(k, val) for k, val in v.parameters.items())
+        if v.contact == "unilateral":
+            params += ", unilateral contact"
         rows.append((v.id, v.model, f"{v.y:.3f}", v.direction, speed, fmt_g(v.entry_time), params))
     heads = ("id", "model", "y [m]", "dir", "speed [m/s]", "entry [s]", "parameters")
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(heads[:-1])]
@@ -261,7 +272,10 @@ def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - 
 def _vehicle_summary(outcome: RunOutcome, limit: int = 12) -> list[str]:
     result = outcome.result
     scripted = [v.id for v in outcome.scenario.vehicles]
-    ids = scripted or sorted(outcome.on_deck, key=lambda v: -result.contact_force_range.get(v, (0, 0))[1])
+    # A scripted vehicle with several axles is reported axle by axle ("truck#0", "truck#1", ...).
+    contacts = [c for vid in scripted for c in (sorted(c for c in outcome.on_deck if vehicle_of(c) == vid
+                                                       and c != vid) or [vid])]
+    ids = contacts or sorted(outcome.on_deck, key=lambda v: -result.contact_force_range.get(v, (0, 0))[1])
     lifted_total = sum(1 for v in outcome.on_deck if result.contact_force_range.get(v, (0.0, 0.0))[0] < 0)
     of = f" of {len(scripted)}" if scripted else ""
     vehicles = {vehicle_of(c) for c in outcome.on_deck}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from typing import Annotated, Any
 
 from pydantic import Field, PlainValidator, Strict, model_validator
@@ -18,7 +19,7 @@ from pydantic import Field, PlainValidator, Strict, model_validator
 from cosim.core.roughness import ISO_CLASSES
 from cosim.core.simulation import SolverSettings
 from cosim.core.traffic import ScriptedVehicle
-from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 from cosim.errors import ConfigError
 
 from .config_base import (
@@ -51,6 +52,8 @@ __all__ = [
     "SensorConfig",
     "SolverConfig",
     "TrafficConfig",
+    "AxleConfig",
+    "CONTACTS",
     "VEHICLE_MODELS",
     "VEHICLE_PARAMETERS",
     "VehicleConfig",
@@ -65,13 +68,19 @@ SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
 
 #: Vehicle models of ``[[vehicles]]`` and their parameters: name -> (required, optional with default).
-VEHICLE_MODELS: dict[str, tuple[tuple[str, ...], dict[str, float]]] = {
+VEHICLE_MODELS: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
     "moving-force": (("mass",), {}),
     "quarter-car": (("m_v", "m_w", "k_v", "c_v"), {}),
     "tyre-quarter-car": (("m_v", "m_w", "k_v", "c_v", "k_t"), {"c_t": 0.0}),
     "golden-car": (("m_v",), {}),
+    "half-car": (("m_b", "cg", "axles"), {"i_b": 0.0, "pitch": True}),
 }
-VEHICLE_PARAMETERS: tuple[str, ...] = ("mass", "m_v", "m_w", "k_v", "c_v", "k_t", "c_t")
+VEHICLE_PARAMETERS: tuple[str, ...] = ("mass", "m_v", "m_w", "k_v", "c_v", "k_t", "c_t", "m_b", "i_b", "cg", "axles",
+                                       "pitch")
+#: ``contact`` of ``[[vehicles]]``: the tyre holds to the deck, or may leave it (models with a tyre only).
+CONTACTS: tuple[str, ...] = ("bilateral", "unilateral")
+#: Models whose tyre may leave the deck.
+TYRE_MODELS: tuple[str, ...] = ("tyre-quarter-car", "golden-car", "half-car")
 DIRECTIONS: dict[str, int] = {"+x": 1, "-x": -1}
 
 #: ``[road].class``: an ISO 8608 class, or a smooth road.
@@ -142,6 +151,21 @@ def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> Problems:
     return fail(str(exc))
 
 
+class AxleConfig(ConfigModel):
+    """``axles = [{...}, ...]`` of a half-car: one axle (both its wheels), positions behind the front axle."""
+
+    distance: NonNegative
+    m_w: Positive
+    k_s: Positive
+    c_s: NonNegative
+    k_t: Positive
+    c_t: NonNegative = 0.0
+
+    def to_axle(self) -> Axle:
+        """The :class:`cosim.core.vehicles.Axle` this table describes."""
+        return Axle(distance=self.distance, m_w=self.m_w, k_s=self.k_s, c_s=self.c_s, k_t=self.k_t, c_t=self.c_t)
+
+
 class VehicleConfig(ConfigModel):
     """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
 
@@ -154,6 +178,12 @@ class VehicleConfig(ConfigModel):
     c_v: Number | None = None
     k_t: Number | None = None
     c_t: Number | None = None
+    m_b: Number | None = None
+    i_b: Number | None = None
+    cg: Number | None = None
+    axles: tuple[AxleConfig, ...] | None = None
+    pitch: Annotated[bool, Strict()] | None = None
+    contact: Annotated[str, choice(CONTACTS, "contact")] = "bilateral"
     y: Number
     speed: Positive | None = None
     entry_time: NonNegative = 0.0
@@ -175,6 +205,11 @@ class VehicleConfig(ConfigModel):
             problems.append((("speed",), "give either speed or profile, not both"))
         if self.speed is None and self.profile is None:
             problems.append((("speed",), "required key is missing (give speed, m/s, or a speed profile)"))
+        if self.contact == "unilateral" and self.model not in TYRE_MODELS:
+            problems.append((("contact",), f"unilateral contact needs a tyre: use one of {', '.join(TYRE_MODELS)} "
+                                           f"(model {show(self.model)} keeps its wheel on the deck)"))
+        if self.axles is not None and not self.axles:
+            problems.append((("axles",), "expected at least one axle, got an empty array"))
         if problems:
             raise Problems(problems)
         try:
@@ -184,8 +219,8 @@ class VehicleConfig(ConfigModel):
         return self
 
     @property
-    def parameters(self) -> dict[str, float]:
-        """The model's parameters, defaults filled in (SI units)."""
+    def parameters(self) -> dict[str, Any]:
+        """The model's parameters, defaults filled in (SI units; a half-car's axles as AxleConfig tables)."""
         required, optional = VEHICLE_MODELS[self.model]
         values = {key: getattr(self, key) for key in required}
         values.update({key: getattr(self, key) if getattr(self, key) is not None else default
@@ -199,13 +234,19 @@ class VehicleConfig(ConfigModel):
             ConfigError: a non-physical parameter (the vehicle classes check them).
         """
         p = self.parameters
+        unilateral = self.contact == "unilateral"
         if self.model == "moving-force":
             return MovingForce(mass=p["mass"])
         if self.model == "quarter-car":
             return QuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"])
         if self.model == "tyre-quarter-car":
-            return TyreQuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"], k_t=p["k_t"], c_t=p["c_t"])
-        return TyreQuarterCar.golden_car(p["m_v"])
+            return TyreQuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"], k_t=p["k_t"], c_t=p["c_t"],
+                                  unilateral=unilateral)
+        if self.model == "half-car":
+            return HalfCar(m_b=p["m_b"], i_b=p["i_b"], cg=p["cg"], axles=tuple(a.to_axle() for a in p["axles"]),
+                           pitch=p["pitch"], unilateral=unilateral)
+        golden = TyreQuarterCar.golden_car(p["m_v"])
+        return replace(golden, unilateral=unilateral) if unilateral else golden
 
     def to_scripted(self) -> ScriptedVehicle:
         """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes."""
