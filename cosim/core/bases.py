@@ -27,19 +27,34 @@ _EMPTY_I = np.zeros(0, dtype=np.int64)
 
 
 class DirectBasis:
-    """All free DOFs of the FE model; banded Cholesky of the effective matrix.
+    """All free DOFs of the FE model: the full finite-element solution.
 
-    Holds what the compiled step needs: the banded factor, K and M (CSR), the
-    Rayleigh coefficients, and the dense inverse of
-    the effective matrix, whose element blocks give the Woodbury capacitance
-    matrix without one solve per vehicle (n^2 doubles: the basis refuses
-    models above ``MAX_DIRECT_DOFS`` and points to the modal basis).
+    Two exact engines solve it (docs/theory.md §6.7-6.8, §12):
+
+    - *banded*: the banded Cholesky factor of the effective matrix, K and M
+      in CSR form, and the dense inverse of the effective matrix, whose
+      entries give the Woodbury capacitance matrix without one solve per
+      vehicle (n^2 doubles: the basis refuses models above
+      ``MAX_DIRECT_DOFS`` and points to the modal basis);
+    - *complete modal*: with Rayleigh damping every mode of the model
+      diagonalises the Newmark/HHT operator, so the same solution costs O(n)
+      per step plus the vehicles' rows projected on the n modes. Far cheaper
+      with few vehicles on the deck (free vibration above all); the block loop
+      uses it for blocks with at most ``COMPLETE_MODAL_MAX_VEHICLES`` contact
+      points and the banded engine for busier ones. Both agree to round-off
+      (1e-10 of the peak, tests/unit/test_direct_engines.py). Built for models
+      up to ``COMPLETE_MODAL_MAX_DOFS`` free DOFs (a dense eigen-solution).
+
+    Args:
+        complete_modal: allow the complete modal engine (False: banded only).
     """
 
     name = "direct"
     MAX_DIRECT_DOFS = 6000
+    COMPLETE_MODAL_MAX_DOFS = 2000
+    COMPLETE_MODAL_MAX_VEHICLES = 8
 
-    def __init__(self, bridge: BridgeModel, dt: float, scheme: Scheme) -> None:
+    def __init__(self, bridge: BridgeModel, dt: float, scheme: Scheme, complete_modal: bool = True) -> None:
         self.bridge, self.dt, self.scheme = bridge, float(dt), scheme
         self.n = len(bridge.free)
         if self.n > self.MAX_DIRECT_DOFS:
@@ -68,6 +83,9 @@ class DirectBasis:
         # Full DOF -> reduced index, -1 for restrained DOFs.
         self.reduced_map = np.full(bridge.ndof, -1, dtype=np.int64)
         self.reduced_map[bridge.free] = np.arange(self.n)
+        self.complete: _CompleteModes | None = None
+        if complete_modal and self.n <= self.COMPLETE_MODAL_MAX_DOFS:
+            self.complete = _CompleteModes(self, scheme, dt)
 
     def _factorize(self, band: np.ndarray) -> np.ndarray:
         """The banded Cholesky factor of the effective matrix: the only factorisation a run does (counted)."""
@@ -82,6 +100,16 @@ class DirectBasis:
             DIRECT, self.n, self.cholesky_rows, self.K.indptr, self.K.indices, self.K.data,
             self.M.indptr, self.M.indices, self.M.data, self.ray_alpha, self.ray_beta, self.inverse,
             self.reduced_map, _EMPTY_2, _EMPTY_1, _EMPTY_1, _EMPTY_1,
+        )
+
+    def complete_kernel_arrays(self) -> BasisArrays:
+        """The complete modal engine's arrays (the physical inverse serves the capacitance matrix)."""
+        c = self.complete
+        if c is None:
+            raise ConfigError("this direct basis was built without its complete modal engine")
+        return BasisArrays(
+            MODAL, self.n, _EMPTY_2, _EMPTY_I, _EMPTY_I, _EMPTY_1, _EMPTY_I, _EMPTY_I, _EMPTY_1, 0.0, 0.0,
+            self.inverse, self.reduced_map, c.phi_full, c.c_diag, c.k_diag, c.a_inv,
         )
 
     def sparse_rows(self, rows: list[DeckRow]) -> tuple[np.ndarray, np.ndarray]:
@@ -120,6 +148,38 @@ class DirectBasis:
     def energy(self, d: np.ndarray, v: np.ndarray) -> float:
         """Kinetic plus strain energy, J."""
         return float(0.5 * v @ (self.M @ v) + 0.5 * d @ (self.K @ d))
+
+
+class _CompleteModes:
+    """Every mode of a direct basis' model, for its complete modal engine (see :class:`DirectBasis`)."""
+
+    def __init__(self, basis: DirectBasis, scheme: Scheme, dt: float) -> None:
+        bridge = basis.bridge
+        # The dense generalized eigen-solution (LAPACK sygvd): mass-normalised modes, Phi^T M Phi = I.
+        w2, phi = scipy.linalg.eigh(bridge.K_ff.toarray(), bridge.M_ff.toarray(), driver="gvd")
+        self.phi = np.ascontiguousarray(phi)  # (n, n), reduced coordinates
+        self.phi_full = np.ascontiguousarray(bridge.expand(phi))  # (ndof, n)
+        self.k_diag = w2
+        self.c_diag = basis.ray_alpha + basis.ray_beta * w2  # Rayleigh: C is diagonal in the modes
+        c = 1.0 + scheme.alpha
+        self.a_inv = 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
+        self._m_phi = basis.M @ self.phi  # M Phi: the modal coordinates of a state are Phi^T M x
+
+    def to_modal(self, x: np.ndarray) -> np.ndarray:
+        """Modal coordinates of a displacement-like reduced vector: eta = Phi^T M x."""
+        return self._m_phi.T @ x
+
+    def from_modal(self, eta: np.ndarray) -> np.ndarray:
+        """The reduced vector of modal coordinates: x = Phi eta."""
+        return self.phi @ eta
+
+    def force_to_modal(self, f: np.ndarray) -> np.ndarray:
+        """Modal components of a force vector: Phi^T f."""
+        return self.phi.T @ f
+
+    def force_from_modal(self, f_modal: np.ndarray) -> np.ndarray:
+        """The force vector of modal components: M Phi f_modal (since Phi^T M Phi = I)."""
+        return self._m_phi @ f_modal
 
 
 class ModalBasis:

@@ -184,7 +184,6 @@ class CoupledSystem:
                                         float(bridge.section.y_s), float(bridge.length),
                                         np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS)
         self._scheme = kernels.StepScheme(self.dt, scheme.beta, scheme.gamma, scheme.alpha)
-        self._basis = basis.kernel_arrays()
         self._y_range = bridge.section.deck_y
         # Fleet (structure of arrays).
         self.ids: tuple[str, ...] = ()
@@ -197,25 +196,63 @@ class CoupledSystem:
         self._vstate = np.zeros((STATE_ROWS, 0))
         self._lifted = np.zeros(0, dtype=bool)
         self.sensors = tuple(sensors)
-        idx, vals = basis.sparse_rows([sensor_row(bridge, s) for s in self.sensors])
+        rows = [sensor_row(bridge, s) for s in self.sensors]
+        idx, vals = basis.sparse_rows(rows)
         order = np.array([TIME_DERIVATIVE[s.quantity] for s in self.sensors], dtype=np.int64)
-        self._sensor_rows = kernels.SensorRows(idx, vals, order)
+        # The engines that solve this basis: name -> (arrays, sensor rows in its coordinates).
+        self._engines = {"basis": (basis.kernel_arrays(), kernels.SensorRows(idx, vals, order))}
+        self._complete = basis.complete if isinstance(basis, DirectBasis) else None
+        if self._complete is not None:
+            dense = np.array([basis.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows],
+                             dtype=float).reshape(len(rows), basis.n)
+            modal_rows = dense @ self._complete.phi
+            modal_idx = np.tile(np.arange(basis.n, dtype=np.int64), (len(rows), 1))
+            self._engines["complete-modal"] = (basis.complete_kernel_arrays(),
+                                               kernels.SensorRows(modal_idx, modal_rows, order))
+        self._engine = "basis"
 
     # ------------------------------------------------------------ bookkeeping
     @property
     def d(self) -> npt.NDArray[np.float64]:
         """Bridge displacements in the basis' coordinates (m, rad)."""
-        return self._state.d
+        return self._in_basis(self._state.d)
 
     @property
     def v(self) -> npt.NDArray[np.float64]:
         """Bridge velocities in the basis' coordinates."""
-        return self._state.v
+        return self._in_basis(self._state.v)
 
     @property
     def a(self) -> npt.NDArray[np.float64]:
         """Bridge accelerations in the basis' coordinates."""
-        return self._state.a
+        return self._in_basis(self._state.a)
+
+    @property
+    def engine(self) -> str:
+        """The engine of the last block: "basis" (the basis' own), or "complete-modal" (a direct basis solved
+        on all its modes, for blocks with few vehicles)."""
+        return self._engine
+
+    def _in_basis(self, x: np.ndarray) -> np.ndarray:
+        if self._engine == "complete-modal":
+            assert self._complete is not None
+            return self._complete.from_modal(x)
+        return x
+
+    def _switch_engine(self, name: str) -> None:
+        """Carry the bridge's state over to another engine's coordinates (exact up to round-off)."""
+        if name == self._engine:
+            return
+        c = self._complete
+        assert c is not None
+        st = self._state
+        if name == "complete-modal":
+            self._state = kernels.BridgeState(c.to_modal(st.d), c.to_modal(st.v), c.to_modal(st.a),
+                                              c.force_to_modal(st.force))
+        else:
+            self._state = kernels.BridgeState(c.from_modal(st.d), c.from_modal(st.v), c.from_modal(st.a),
+                                              c.force_from_modal(st.force))
+        self._engine = name
 
     @property
     def liftoff_events(self) -> int:
@@ -239,6 +276,7 @@ class CoupledSystem:
         for name, value in zip(("d", "v", "a"), values):
             if value.shape != (n,) or not np.all(np.isfinite(value)):
                 raise ConfigError(f"`{name}` must be {n} finite numbers (the basis' unknowns)")
+        self._switch_engine("basis")
         self._state = kernels.BridgeState(values[0], values[1], values[2], self._state.force)
 
     def _deck_w(self, x: float, y: float) -> float:
@@ -379,7 +417,10 @@ class CoupledSystem:
             np.ascontiguousarray(block.x, dtype=float), np.ascontiguousarray(block.v, dtype=float),
             np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x))
         self._counters[3] = 0
-        kernels.advance_block(self._basis, self._deck, self._scheme, self._state, fleet, kin, self._sensor_rows, out,
+        few = self._complete is not None and q <= DirectBasis.COMPLETE_MODAL_MAX_VEHICLES
+        self._switch_engine("complete-modal" if few else "basis")
+        arrays, sensor_rows = self._engines[self._engine]
+        kernels.advance_block(arrays, self._deck, self._scheme, self._state, fleet, kin, sensor_rows, out,
                               self._groups)
         self.basis.n_solves = int(self._counters[2])
         if self._counters[3]:

@@ -192,20 +192,33 @@ def internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha):  # noqa: AN
 
 
 @compiled
-def project_contacts(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
-    """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values."""
+def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
+    """Contact rows at the few reduced DOFs a deck point depends on (-1: restrained or off the deck)."""
+    dofs = deck.dofs
+    for i in range(elems.shape[0]):
+        e = elems[i]
+        for kk in range(dofs.shape[0]):
+            k = dofs[kk]
+            idx[i, kk] = basis.reduced[deck.node_dofs * e + k] if e >= 0 else -1
+            rv[i, 0, kk] = vals[i, 0, k]
+            rv[i, 1, kk] = vals[i, 1, k]
+            rv[i, 2, kk] = vals[i, 2, k]
+
+
+@compiled
+def project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
+    """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values.
+
+    A complete modal engine (``basis.inverse`` given) also keeps the physical rows
+    (``pidx``, ``prv``) for the capacitance matrix.
+    """
     q = elems.shape[0]
     dofs = deck.dofs
     if basis.kind == DIRECT:
-        for i in range(q):
-            e = elems[i]
-            for kk in range(dofs.shape[0]):
-                k = dofs[kk]
-                idx[i, kk] = basis.reduced[deck.node_dofs * e + k] if e >= 0 else -1
-                rv[i, 0, kk] = vals[i, 0, k]
-                rv[i, 1, kk] = vals[i, 1, k]
-                rv[i, 2, kk] = vals[i, 2, k]
+        _physical_rows(basis, deck, elems, vals, idx, rv)
     else:
+        if basis.inverse.shape[0] > 0:
+            _physical_rows(basis, deck, elems, vals, pidx, prv)
         m = basis.n
         for i in range(q):
             for j in range(m):
@@ -262,16 +275,37 @@ def _mix_groups(groups, S, pz):  # noqa: ANN001, ANN201
 
 
 @compiled
-def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups):  # noqa: ANN001, ANN201
+def _capacitance(ainv, idx, rv, p, groups, S):  # noqa: ANN001, ANN201
+    """S = I + P A^-1 U^T from the entries of the dense physical inverse at the rows' few DOFs."""
+    q, nnz = idx.shape
+    for i in range(q):
+        for jv in range(q):
+            s = 1.0 if i == jv and groups.col[i] < 0 else 0.0
+            for kk in range(nnz):
+                r_ = idx[i, kk]
+                if r_ < 0:
+                    continue
+                acc_ = 0.0
+                for ll in range(nnz):
+                    c_ = idx[jv, ll]
+                    if c_ >= 0:
+                        acc_ += ainv[r_, c_] * rv[jv, 0, ll]
+                s += p[i, kk] * acc_
+            S[i, jv] = s
+
+
+@compiled
+def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pidx, prv, pp):  # noqa: ANN001, ANN201
     """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
 
     Capacitance matrix ``S = I + P A^-1 U^T``: on the direct basis from the
     dense inverse's entries at the rows' few unknowns (no solve per vehicle);
-    on a modal basis A is diagonal.
+    on a modal basis A is diagonal (a complete modal engine uses the physical
+    inverse's entries instead: 64 products per pair rather than one per mode).
+    ``coef`` holds the rows' c0, c1, c2.
     """
     q, nnz = idx.shape
     if basis.kind == DIRECT:
-        ainv = basis.inverse
         for i in range(q):
             s = 0.0
             for kk in range(nnz):
@@ -279,19 +313,7 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups):  # noqa
                 if j >= 0:
                     s += p[i, kk] * z_b[j]
             pz[i] = s
-            for jv in range(q):
-                s = 1.0 if i == jv and groups.col[i] < 0 else 0.0
-                for kk in range(nnz):
-                    r_ = idx[i, kk]
-                    if r_ < 0:
-                        continue
-                    acc_ = 0.0
-                    for ll in range(nnz):
-                        c_ = idx[jv, ll]
-                        if c_ >= 0:
-                            acc_ += ainv[r_, c_] * rv[jv, 0, ll]
-                    s += p[i, kk] * acc_
-                S[i, jv] = s
+        _capacitance(basis.inverse, idx, rv, p, groups, S)
         _mix_groups(groups, S, pz)
         sol = np.linalg.solve(S, pz)
         for j in range(us.shape[0]):
@@ -313,11 +335,18 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups):  # noqa
             for j in range(m):
                 s += p[i, j] * z_b[j]
             pz[i] = s
-            for k in range(q):
-                s = 1.0 if i == k and groups.col[i] < 0 else 0.0
-                for j in range(m):
-                    s += p[i, j] * (a_inv[j] * rv[k, 0, j])
-                S[i, k] = s
+        if basis.inverse.shape[0] > 0:
+            for i in range(q):
+                for kk in range(pidx.shape[1]):
+                    pp[i, kk] = coef[0, i] * prv[i, 0, kk] + coef[1, i] * prv[i, 1, kk] + coef[2, i] * prv[i, 2, kk]
+            _capacitance(basis.inverse, pidx, prv, pp, groups, S)
+        else:
+            for i in range(q):
+                for k in range(q):
+                    s = 1.0 if i == k and groups.col[i] < 0 else 0.0
+                    for j in range(m):
+                        s += p[i, j] * (a_inv[j] * rv[k, 0, j])
+                    S[i, k] = s
         _mix_groups(groups, S, pz)
         sol = np.linalg.solve(S, pz)
         for j in range(m):
@@ -481,13 +510,18 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     tau1 = np.empty(q)
     w_end = np.empty(q)
     wd_end = np.empty(q)
+    ndeck = deck.dofs.shape[0]
+    pidx = np.empty((q, ndeck), dtype=np.int64)
+    prv = np.empty((q, 3, ndeck))
+    pp = np.empty((q, ndeck))
+    coef = np.empty((3, q))
     for step in range(kin.x.shape[0]):
         for j in range(n):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
         internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
         contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals)
-        project_contacts(basis, deck, elems, vals, idx, rv)
+        project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
             s0 = s1 = s2 = s3 = s4 = 0.0
@@ -516,7 +550,9 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                         rhs[j] += rv[i, 0, kk] * e0[i]
             solve(basis, rhs, z_b, out.counters)
             if q > 0:
-                woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters, groups)
+                for i in range(q):
+                    coef[0, i], coef[1, i], coef[2, i] = c0[i], c1[i], c2[i]
+                woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters, groups, coef, pidx, prv, pp)
             if not groups.unilateral or attempt == MAX_CONTACT_SWITCHES:
                 break
             # Unilateral contact: does the trial step agree with the contact states it assumed?

@@ -1,9 +1,12 @@
 """Every bundled scenario and example gives the numbers it gave before the package was reorganised.
 
 Reference: the logs in ``logs/``, written by this test (``COSIM_WRITE_REFERENCE=1``)
-with the code before the move (issue 9). Tolerance: 1e-12 of each channel's
-peak: the move and the single compiled loop change where code lives, not the
-arithmetic.
+with the code before the move (issue 9). Tolerance: 1e-9 of each channel's
+peak. The move and the single compiled loop changed where code lives, not the
+arithmetic (they passed at 1e-12); since then the direct basis solves blocks
+with few vehicles on the model's complete modal basis, which is the same
+solution with other round-off (issue 12 allows 1e-9 of the peak; measured at
+most 4.7e-10, on an acceleration channel).
 """
 from __future__ import annotations
 
@@ -15,7 +18,7 @@ from cosim import testing as ct
 
 from .reference_runs import LOGS, RUNS, WRITE_ENV
 
-REL_PEAK = 1e-12  # of each channel's peak over the stored samples
+REL_PEAK = 1e-9  # of each channel's peak over the stored samples
 
 
 @pytest.mark.parametrize("name", sorted(RUNS))

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.core.bases import make_basis
+from cosim.core.bases import DirectBasis, make_basis
 from cosim.core.bridge import ExplicitDamping, build_bridge
 from cosim.core.coupling import CoupledSystem
 from cosim.core.roughness import RoadProfile
@@ -151,7 +151,7 @@ def test_a_vehicle_off_the_deck_loads_nothing():
 def test_the_basis_counts_its_factorisations_and_the_loop_its_solves():
     bridge = _bridge()
     dt, scheme = 5e-3, Scheme.newmark()
-    basis = make_basis(bridge, dt, scheme)
+    basis = DirectBasis(bridge, dt, scheme, complete_modal=False)  # the banded engine only
     system = CoupledSystem(bridge, basis, scheme, dt)
     car = QuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4)
     for k in range(5):  # five blocks, vehicles on the deck in the last three
@@ -227,3 +227,32 @@ def test_a_basis_built_for_another_bridge_or_step_is_refused():
         CoupledSystem(bridge, make_basis(other, 5e-3, scheme), scheme, 5e-3)
     with pytest.raises(ConfigError, match="built for dt = 0.005 s"):
         CoupledSystem(bridge, make_basis(bridge, 5e-3, scheme), scheme, 1e-3)
+
+
+def test_the_direct_basis_engines_agree_and_switch_with_the_number_of_vehicles():
+    """The complete modal engine and the banded one solve the same full FE problem (Rayleigh damping makes the
+    Newmark/HHT operator diagonal in the modes): round-off agreement, 1e-9 of the peak (issue 12's bound)."""
+    bridge = _bridge()
+    dt, scheme = 2e-3, Scheme.hht(-0.1)
+    car = QuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4)
+    few = DirectBasis.COMPLETE_MODAL_MAX_VEHICLES
+    sensors = (Sensor("mid", 15.0, 2.0), Sensor("acc", 9.0, -1.0, "acceleration"))
+    outputs = {}
+    for allowed in (True, False):
+        basis = DirectBasis(bridge, dt, scheme, complete_modal=allowed)
+        system = CoupledSystem(bridge, basis, scheme, dt, sensors=sensors)
+        engines, records = [], []
+        for q in (0, 2, few + 3, 1, 0):  # free vibration, few vehicles, many, few, none
+            x = np.linspace(2.0, 28.0, q)[None, :] + 0.4 * np.arange(1, 301)[:, None] * dt * 10
+            block = TrafficBlock(tuple(f"c{k}" for k in range(q)), (car,) * q, x, np.full_like(x, 4.0),
+                                 np.zeros_like(x), np.linspace(-3.0, 3.0, q))
+            records.append(system.advance(block).sensors)
+            engines.append(system.engine)
+        outputs[allowed] = np.concatenate(records)
+        if allowed:
+            assert engines == ["complete-modal", "complete-modal", "basis", "complete-modal", "complete-modal"]
+        else:
+            assert set(engines) == {"basis"}
+    for k in range(len(sensors)):
+        ref = outputs[False][:, k]
+        assert np.max(np.abs(outputs[True][:, k] - ref)) <= 1e-9 * np.max(np.abs(ref))
