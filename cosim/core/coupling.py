@@ -202,7 +202,7 @@ class CoupledSystem:
         # The engines that solve this basis: name -> (arrays, sensor rows in its coordinates).
         self._engines = {"basis": (basis.kernel_arrays(), kernels.SensorRows(idx, vals, order))}
         self._complete = basis.complete if isinstance(basis, DirectBasis) else None
-        if self._complete is not None:
+        if self._complete is not None and isinstance(basis, DirectBasis):
             dense = np.array([basis.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows],
                              dtype=float).reshape(len(rows), basis.n)
             modal_rows = dense @ self._complete.phi
