@@ -753,7 +753,8 @@ def thin_walled_properties(plates: Sequence[Plate]) -> SectionProperties:
     A_sz = shear_area(*np.linalg.solve(inertia, [0.0, 1.0]))
     # Secondary torsion (docs/theory.md §10.2): the warping stress -E omega psi' is balanced by the flow
     # q = (T_w / I_w) integral(omega t ds) from the free ends, whose energy defines I_ws = I_w^2 / integral(q^2/t ds).
-    I_ws = I_w**2 * flow_stiffness(omega_s) if I_w > 0 else math.inf
+    i_ps = I_y + I_z + area * ((y_s - y_c) ** 2 + (z_s - z_c) ** 2)
+    I_ws = float(I_w**2 * flow_stiffness(omega_s)) if I_w > _NO_WARPING * i_ps**2 / area else math.inf
 
     corners = np.array([pt for r in rows for pt in _rectangle(*r)])
     return SectionProperties(
