@@ -368,7 +368,7 @@ class BridgeConfig(ConfigModel):
 
     @model_validator(mode="after")
     def _counts(self) -> BridgeConfig:
-        problems = []
+        problems: list[tuple[tuple[str, ...], str]] = []
         n = len(self.spans)
         if isinstance(self.elements_per_span, tuple) and len(self.elements_per_span) != n:
             problems.append(
