@@ -32,6 +32,7 @@ __all__ = [
     "i_section_warping_shear_constant",
     "channel_warping_shear_constant",
     "VBI2D_SPRUNG",
+    "vbi2d_sprung_case",
     "lateral_torsional_frequencies_hz",
     "fryba_midspan_deflection",
     "sprung_mass_modal_solution",
@@ -397,3 +398,27 @@ def yang_yau_case():
 # at -0.41855 mm at t = 0.436 s.
 VBI2D_SPRUNG = {"L": 25.0, "E": 3.5e10, "I": 1.3901, "m": 18358.0, "m_v": 5750.0, "k_v": 1.595e6, "v": 25.0,
                 "peak_w": -0.41855e-3, "peak_t": 0.436}
+
+
+def vbi2d_sprung_case(n_el: int = 20):
+    """VBI-2D's sprung-vehicle case as a cosim model: (bridge, traffic, crossing time), Python API.
+
+    The same model as ``examples/scenarios/vbi2d-sprung-mass.toml``: Euler-Bernoulli
+    bending, the mass per length given, no rotary inertia; the body is a
+    quarter-car without wheel mass; A, J, I_z and rho only set modes this 2D case
+    does not excite.
+    """
+    from cosim.core.bridge import BeamTheory, build_bridge
+    from cosim.core.section import section_from_constants
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.vehicles import QuarterCar
+
+    p = VBI2D_SPRUNG
+    material = Material(E=p["E"], G=p["E"] / 2.4, rho=2500.0)
+    section = section_from_constants(A=7.3432, I_y=p["I"], I_z=20.0, J=2.0, mass_per_length=p["m"],
+                                     rotary_inertia=False, deck_y=(-2.5, 2.5))
+    bridge = build_bridge([p["L"]], n_el, material, section, ["pinned", "fork"],
+                          theory=BeamTheory(bending="euler-bernoulli"))
+    car = QuarterCar(m_v=p["m_v"], m_w=0.0, k_v=p["k_v"], c_v=0.0)
+    traffic = ScriptedTraffic((ScriptedVehicle("sprung", car, 0.0, p["v"]),), p["L"])
+    return bridge, traffic, p["L"] / p["v"]

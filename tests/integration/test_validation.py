@@ -49,6 +49,8 @@ def test_the_brief_s_cases_are_all_there(quick_report: ValidationReport) -> None
         "lateral-torsional", "Fryba), α = 0.1", "Fryba), α = 0.5", "sprung mass: mid-span deflection",
         "sprung mass: body acceleration", "Energy conservation", "Time-step convergence",
         "roughness PSD, class A", "roughness PSD, class C", "Mesh convergence",
+        "Benscoter torsion, mid-span torque, warping restrained", "Benscoter torsional frequencies",
+        "Benscoter torsion, mesh convergence", "Vlasov vs Benscoter", "VBI-2D sprung vehicle",
     ):
         assert expected in names, expected
 
@@ -69,7 +71,8 @@ def test_every_plot_is_a_real_png(quick_report: ValidationReport) -> None:
     plots = quick_report.plots
     expected = {"paper_node1.png", "paper_node2.png", "paper_node3.png", "paper_asymmetric.png",
                 "timoshenko_static.png", "torsion_static.png", "fryba_moving_force.png", "sprung_mass.png",
-                "energy_drift.png", "time_step_convergence.png", "roughness_psd.png", "mesh_convergence.png"}
+                "energy_drift.png", "time_step_convergence.png", "roughness_psd.png", "mesh_convergence.png",
+                "benscoter_torsion.png", "paper_torsion_theories.png", "vbi2d_sprung_mass.png"}
     assert expected <= {p.name for p in plots}
     for plot in plots:
         assert plot.parent == quick_report.out_dir

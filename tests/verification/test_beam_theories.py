@@ -165,3 +165,13 @@ def test_the_vbi2d_sprung_vehicle_case_within_half_a_percent():
     f1 = res.frequencies(1)[0]
     ref = euler_bernoulli_ss_frequency_hz(1, 25.0, VBI2D_SPRUNG["E"] * VBI2D_SPRUNG["I"], VBI2D_SPRUNG["m"])
     assert f1 == pytest.approx(float(ref), rel=1e-4)
+
+
+def test_the_example_file_and_the_validation_case_are_one_model():
+    """cosim validate builds the VBI-2D case through the Python API; it must be the example file's model."""
+    from cosim.validation.references import vbi2d_sprung_case
+
+    api, _, _ = vbi2d_sprung_case()
+    from_file = load_scenario(EXAMPLES / "vbi2d-sprung-mass.toml").build_bridge()
+    assert (api.K != from_file.K).nnz == 0 and (api.M != from_file.M).nnz == 0
+    assert api.theory == from_file.theory and api.section == replace(from_file.section, source=api.section.source)
