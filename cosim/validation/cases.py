@@ -1302,7 +1302,7 @@ def _study_vbi2d(run: _Run) -> list[CaseResult]:
     error = abs(w[k] / p["peak_w"] - 1.0)
     return [CaseResult(
         name="VBI-2D sprung vehicle: mid-span peak",
-        reference="VBI-2D verification case 'SprungVeh' (D. Cantero, SoftwareX 13, 100725, 2021; "
+        reference="VBI-2D verification case 'SprungVeh' (D. Cantero, github.com/DanielCanteroNTNU/VBI-2D, "
                   "V01_Analytical_Verification_Examples.m): -0.41855 mm at 0.436 s",
         metric="abs(w_peak / w_peak,ref - 1)",
         error=error, tolerance=TOL_VBI2D, passed=_judge(error, TOL_VBI2D) and abs(res.t[k] - p["peak_t"]) <= 0.005,

@@ -391,8 +391,8 @@ def yang_yau_case():
     return bridge, traffic, p["L"] / p["v"]
 
 
-# VBI-2D's sprung-vehicle verification case (D. Cantero, SoftwareX 13, 100725, 2021;
-# github.com/DanielCanteroNTNU/VBI-2D, V01_Analytical_Verification_Examples.m, "SprungVeh"):
+# VBI-2D's sprung-vehicle verification case (D. Cantero, VBI-2D, github.com/DanielCanteroNTNU/VBI-2D,
+# V01_Analytical_Verification_Examples.m, "SprungVeh"):
 # L 25 m, E 3.5e10 Pa, I 1.3901 m^4, 18358 kg/m, undamped; body 5750 kg on 1.595e6 N/m, no damper and
 # no wheel mass, 25 m/s, at x = 0 at t = 0; its modal Newmark solution (100 modes, dt 1 ms) peaks at mid-span
 # at -0.41855 mm at t = 0.436 s.

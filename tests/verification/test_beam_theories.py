@@ -152,7 +152,7 @@ def test_euler_bernoulli_frequencies_with_a_mass_per_length():
 def test_the_vbi2d_sprung_vehicle_case_within_half_a_percent():
     """examples/scenarios/vbi2d-sprung-mass.toml against VBI-2D's verification case "SprungVeh".
 
-    Reference: D. Cantero, VBI-2D (SoftwareX 13, 100725, 2021), V01_Analytical_Verification_Examples.m: a 5750 kg
+    Reference: D. Cantero, VBI-2D (github.com/DanielCanteroNTNU/VBI-2D), V01_Analytical_Verification_Examples.m: 5750 kg
     body on 1.595e6 N/m (no wheel mass, no damper) at 25 m/s on a 25 m beam (E I = 3.5e10 x 1.3901 N m2,
     18358 kg/m), entering at x = 0 at t = 0; mid-span peak -0.41855 mm at 0.436 s.
     """
