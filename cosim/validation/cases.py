@@ -1121,7 +1121,7 @@ def _study_benscoter(run: _Run) -> list[CaseResult]:
     theory = BeamTheory(torsion="benscoter")
     E, G = STEEL.E, STEEL.G
     L, T, n_el = 10.0, 1.0e4, 40
-    gj, eiw, giws = G * sec.J, E * sec.I_w, G * sec.I_ws
+    gj, eiw, giws = G * sec.J, E * sec.I_w, G * _STOCKY_I_WS
     fig, axes = _figure(1, 3, size=(14.0, 4.2))
     cases = []
 
