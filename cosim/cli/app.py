@@ -346,8 +346,9 @@ def build_parser() -> argparse.ArgumentParser:
             ISO 8608 spectra, a parked vehicle, Benscoter torsion against its closed forms
             and frequency equation, VBI-2D's sprung vehicle on an Euler-Bernoulli beam) and
             the paper's 40 m double-tee case (Nodes 1-3 like its Figs. 4-6, quarter-cars
-            and moving forces, direct and modal bases, Vlasov and Benscoter torsion). Writes DIR/report.md with each case's reference, error and
-            tolerance, and PNG plots next to it.
+            and moving forces, direct and modal bases, Vlasov and Benscoter torsion).
+            Writes DIR/report.md with each case's reference, error and tolerance, and PNG
+            plots next to it.
 
             Exit status: 0 every case within its tolerance, 1 a case failed, 2 bad input."""
         ),
