@@ -24,7 +24,7 @@ _EXPORTS: dict[str, str] = {
     "Material": "cosim.core.section", "Plate": "cosim.core.section", "SectionProperties": "cosim.core.section",
     "section_from_plates": "cosim.core.section", "section_from_constants": "cosim.core.section",
     "BridgeModel": "cosim.core.bridge", "build_bridge": "cosim.core.bridge", "PointLoad": "cosim.core.bridge",
-    "RayleighDamping": "cosim.core.bridge", "ExplicitDamping": "cosim.core.bridge",
+    "RayleighDamping": "cosim.core.bridge", "ExplicitDamping": "cosim.core.bridge", "BeamTheory": "cosim.core.element",
     "ModalResult": "cosim.core.bridge", "StaticResult": "cosim.core.bridge",
     # vehicles, traffic, road, sensors
     "MovingForce": "cosim.core.vehicles", "QuarterCar": "cosim.core.vehicles",

@@ -1,9 +1,10 @@
 """The ``cosim`` command line: the parser, :func:`main` and how errors become exit statuses.
 
 Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
-:mod:`.study`, :mod:`.validate`)::
+:mod:`.static`, :mod:`.study`, :mod:`.validate`)::
 
     cosim modes SCENARIO [--count N] [--json] [--plot FILE.png]
+    cosim static SCENARIO --load X Y FZ [--load X Y FZ ...] [--json]
     cosim run [SCENARIO] [--out LOG.mcap] [--csv OUT.csv] [--force] [--quiet]
     cosim replay LOG.mcap [--scenario OTHER] [--out NEW.mcap] [--force] [--quiet]
     cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--force]
@@ -26,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import textwrap
 
@@ -40,6 +42,7 @@ from cosim.run.static import STATIC_LOAD_N
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
+from .static import cmd_static
 from .study import cmd_study
 from .text import EXIT_INTERRUPTED, EXIT_USAGE, report_error
 from .validate import cmd_validate
@@ -54,6 +57,21 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value}")
     return value
+
+
+def finite_float(text: str) -> float:
+    """argparse type: a finite number (``nan`` and ``inf`` are refused)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if value != value or value in (float("inf"), float("-inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+#: Negative numbers argparse must read as values, not options: Python < 3.13 reads "-1e5" as an option.
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
 def bundled_text() -> str:
@@ -85,6 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
               cosim plot run1.mcap -o run1.png
               cosim replay run1.mcap --scenario other-bridge.toml
               cosim modes paper-double-tee --count 12 --plot modes.png
+              cosim static paper-double-tee --load 20 3.325 -100e3
             """
         )
         + "\n"
@@ -123,12 +142,45 @@ def build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--count", "-n", type=positive_int, default=10, metavar="N",
                        help="number of modes to compute (default: 10)")
     modes.add_argument("--json", action="store_true",
-                       help="print JSON (scenario, section, damping, modes with n, f_hz, kind, participation) "
-                            "and nothing else on stdout")
+                       help="print JSON (scenario, theory, section, damping, nodes_x, modes with n, f_hz, kind, "
+                            "participation and the mass-normalised nodal shape: w on the axis, theta_x, v) and "
+                            "nothing else on stdout")
     modes.add_argument("--plot", metavar="FILE.png",
                        help=f"draw the first N (at most {MAX_MODE_SHAPES}) mode shapes: v, w and twist theta_x "
                             "along x, each normalised")
     modes.set_defaults(func=cmd_modes)
+
+    static = commands.add_parser(
+        "static",
+        help="static deck displacements under point loads anywhere on the deck",
+        description=textwrap.dedent(
+            """\
+            Build the scenario's bridge, load it with the given vertical point loads acting
+            together (consistent nodal loads, a static solve) and print the deck
+            displacement under each load and at every sensor's point (mm, positive up),
+            with the bending moment at bending-moment sensors. A load off the deck is an
+            error (exit status 2). Vehicles and traffic of the scenario are ignored."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim static paper-double-tee --load 20 3.325 -100e3
+              cosim static paper-double-tee --load 20 3.325 -50e3 --load 20 -3.325 -50e3 --json
+            """
+        )
+        + "\n"
+        + bundled_text(),
+        formatter_class=formatter,
+    )
+    static.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml) or bundled scenario name")
+    static.add_argument("--load", nargs=3, type=finite_float, action="append", required=True,
+                        metavar=("X", "Y", "FZ"),
+                        help="a point load: x along the bridge (m), y lateral (m, positive left), Fz (N, positive "
+                             "up: a downward load is negative); repeat for more loads")
+    static.add_argument("--json", action="store_true",
+                        help="print JSON (scenario, theory, loads and sensors with w in m, units) and nothing else")
+    static._negative_number_matcher = NEGATIVE_NUMBER  # "-1e5" is a value here (see NEGATIVE_NUMBER)
+    static.set_defaults(func=cmd_static)
 
     run = commands.add_parser(
         "run",
@@ -291,10 +343,12 @@ def build_parser() -> argparse.ArgumentParser:
             (Timoshenko statics and frequencies, non-uniform torsion, torsional and coupled
             lateral-torsional frequencies, Fryba's moving force, a sprung mass against an
             independent modal ODE, energy conservation, time-step and mesh convergence,
-            ISO 8608 spectra, a parked vehicle) and the paper's 40 m double-tee case
-            (Nodes 1-3 like its Figs. 4-6, quarter-cars and moving forces, direct and
-            modal bases). Writes DIR/report.md with each case's reference, error and
-            tolerance, and PNG plots next to it.
+            ISO 8608 spectra, a parked vehicle, Benscoter torsion against its closed forms
+            and frequency equation, VBI-2D's sprung vehicle on an Euler-Bernoulli beam) and
+            the paper's 40 m double-tee case (Nodes 1-3 like its Figs. 4-6, quarter-cars
+            and moving forces, direct and modal bases, Vlasov and Benscoter torsion).
+            Writes DIR/report.md with each case's reference, error and tolerance, and PNG
+            plots next to it.
 
             Exit status: 0 every case within its tolerance, 1 a case failed, 2 bad input."""
         ),

@@ -5,12 +5,27 @@ import argparse
 import json
 
 from cosim import plots
+from cosim.core.bridge import BridgeModel
 from cosim.run.figures import plot_modes
 from cosim.run.outputs import check_writable
-from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
+from cosim.run.payloads import SHAPE_NOTE, damping_payload, jsonable, modes_payload, section_payload
 from cosim.run.scenario import load_scenario
 
 from .text import damping_lines, modes_lines, print_lines, scenario_line, section_lines
+
+
+def theory_lines(bridge: BridgeModel) -> list[str]:
+    """The element's theories (docs/theory.md §10), and the constants only they use."""
+    theory, section = bridge.theory, bridge.section
+    lines = [f"Element: {theory.torsion} torsion, {theory.bending} bending"]
+    if section.I_ws is not None:
+        lines.append(f"  I_ws   = {section.I_ws:.6g} m^4   (warping shear, secondary torsion"
+                     f"{'' if theory.torsion == 'benscoter' else '; used by torsion = benscoter'})")
+    if section.mass_per_length is not None:
+        lines.append(f"  mass   = {section.mass_per_length:.6g} kg/m   (given, replaces rho A)")
+    if not section.rotary_inertia:
+        lines.append("  rotary inertia of the bending rotations: off")
+    return lines
 
 
 def cmd_modes(args: argparse.Namespace) -> int:
@@ -24,7 +39,10 @@ def cmd_modes(args: argparse.Namespace) -> int:
         payload = {
             "scenario": scenario.title,
             "source": scenario.source,
-            "modes": modes_payload(modal),
+            "theory": {"torsion": bridge.theory.torsion, "bending": bridge.theory.bending},
+            "nodes_x": bridge.nodes_x,
+            "shape_note": SHAPE_NOTE,
+            "modes": modes_payload(modal, shapes=True),
             "section": section_payload(bridge.section),
             "damping": damping_payload(bridge),
         }
@@ -32,6 +50,7 @@ def cmd_modes(args: argparse.Namespace) -> int:
     else:
         print_lines([scenario_line(scenario), ""])
         print_lines(section_lines(bridge.section))
+        print_lines(theory_lines(bridge))
         print_lines(["", *damping_lines(bridge), ""])
         print_lines(modes_lines(modal))
     if args.plot:

@@ -25,21 +25,25 @@ from cosim.errors import ConfigError, ModelError
 
 from .banded import upper_band
 from .element import (
+    DEFAULT_THEORY,
     DOF_INDEX,
     DOF_NAMES,
     ELEMENT_DOFS,
     FIELD_INDEX,
     NODE_DOFS,
+    BeamTheory,
     DeckRow,
     deck_row_values,
     element_matrices,
     field_matrix,
     shape_coefficients,
     shear_parameters,
+    torsion_parameter,
 )
 from .section import Material, SectionProperties
 
 __all__ = [
+    "BeamTheory",
     "DOF_NAMES",
     "SUPPORT_PRESETS",
     "MODE_KINDS",
@@ -206,6 +210,7 @@ class BridgeModel:
         restrained: sorted global DOF indices held by supports.
         K, M: full sparse stiffness (N/m, N, N m) and consistent mass (kg, kg m, kg m^2).
         alpha, beta: Rayleigh coefficients in use (1/s, s); zero when undamped.
+        theory: the torsion and bending theories of the elements (docs/theory.md §10).
     """
 
     spans: tuple[float, ...]
@@ -219,6 +224,7 @@ class BridgeModel:
     alpha: float = 0.0
     beta: float = 0.0
     damping_note: str = "undamped"
+    theory: BeamTheory = DEFAULT_THEORY
 
     # ----------------------------------------------------------------- sizes
     @property
@@ -251,11 +257,12 @@ class BridgeModel:
         return np.concatenate([[0.0], np.cumsum(self.spans)])
 
     @cached_property
-    def _element_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per element: length, phi_y, phi_z."""
+    def _element_data(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Per element: length, phi_y, phi_z, phi_t."""
         lengths = np.diff(self.nodes_x)
-        phis = np.array([shear_parameters(L, self.material, self.section) for L in lengths])
-        return lengths, phis[:, 0], phis[:, 1]
+        phis = np.array([shear_parameters(L, self.material, self.section, self.theory) for L in lengths])
+        phi_t = np.array([torsion_parameter(L, self.material, self.section, self.theory) for L in lengths])
+        return lengths, phis[:, 0], phis[:, 1], phi_t
 
     # ------------------------------------------------------- reduced matrices
     @cached_property
@@ -305,18 +312,18 @@ class BridgeModel:
         moving-contact kinematics need.
         """
         e, xi = self.locate(x)
-        lengths, phi_y, phi_z = self._element_data
-        values = deck_row_values(xi, lengths[e], phi_y[e], phi_z[e], y - self.section.y_s)
+        lengths, phi_y, phi_z, phi_t = self._element_data
+        values = deck_row_values(xi, lengths[e], phi_y[e], phi_z[e], y - self.section.y_s, phi_t[e])
         return DeckRow(dofs=self._element_dofs(e), values=values)
 
     @cached_property
     def _deck_coefficients(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per element: polynomial coefficients of w and theta_x (n_el, 14, 4), and lengths."""
-        lengths, phi_y, phi_z = self._element_data
+        lengths, phi_y, phi_z, phi_t = self._element_data
         c_w = np.empty((self.n_elements, ELEMENT_DOFS, 4))
         c_t = np.empty_like(c_w)
         for e in range(self.n_elements):
-            c = shape_coefficients(float(lengths[e]), float(phi_y[e]), float(phi_z[e]))
+            c = shape_coefficients(float(lengths[e]), float(phi_y[e]), float(phi_z[e]), float(phi_t[e]))
             c_w[e], c_t[e] = c[FIELD_INDEX["w"]], c[FIELD_INDEX["theta_x"]]
         return c_w, c_t, lengths
 
@@ -351,8 +358,8 @@ class BridgeModel:
     def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0) -> DeckRow:
         """Row mapping the element DOFs at ``x`` (m) to a field value.
 
-        ``name`` is one of u, v, w, theta_x, theta_y, theta_z (interpolated with
-        the element's shape functions), ``psi`` (= theta_x'), ``w_deck`` (the
+        ``name`` is one of u, v, w, theta_x, theta_y, theta_z, psi (interpolated with
+        the element's shape functions; psi = theta_x' for Vlasov torsion), ``w_deck`` (the
         vertical displacement of the deck point at lateral position ``y``, m),
         or ``bending_moment`` (vertical bending moment about the centroidal y
         axis, N m, sagging positive: ``M = -E (I_y theta_y' - I_yz theta_z')``,
@@ -360,21 +367,19 @@ class BridgeModel:
         x-derivatives. Only ``values[0]`` of the returned row is filled.
         """
         e, xi = self.locate(x)
-        lengths, phi_y, phi_z = self._element_data
-        extra = 1 if name in ("bending_moment", "psi") else 0
-        n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra)[0]
+        lengths, phi_y, phi_z, phi_t = self._element_data
+        extra = 1 if name == "bending_moment" else 0
+        n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra, phi_t[e])[0]
         if name == "bending_moment":
             sec = self.section
             row = -self.material.E * (sec.I_y * n[FIELD_INDEX["theta_y"]] - sec.I_yz * n[FIELD_INDEX["theta_z"]])
-        elif name == "psi":
-            row = n[FIELD_INDEX["theta_x"]]
         elif name == "w_deck":
             row = n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]
         elif name in FIELD_INDEX:
             row = n[FIELD_INDEX[name]]
         else:
             raise ModelError(
-                f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, psi, w_deck, bending_moment)"
+                f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, w_deck, bending_moment)"
             )
         return DeckRow(dofs=self._element_dofs(e), values=row[None, :])
 
@@ -536,6 +541,7 @@ def build_bridge(
     section: SectionProperties,
     supports: Sequence[SupportSpec],
     damping: Union[RayleighDamping, ExplicitDamping, None] = None,
+    theory: BeamTheory | None = None,
 ) -> BridgeModel:
     """Assemble a continuous beam bridge.
 
@@ -547,6 +553,8 @@ def build_bridge(
         supports: one entry per support line (``len(spans) + 1``): a preset
             name from :data:`SUPPORT_PRESETS` or a list of DOF names to restrain.
         damping: Rayleigh damping from two modes' ratios, explicit alpha/beta, or None.
+        theory: torsion ("vlasov" | "benscoter") and bending ("timoshenko" |
+            "euler-bernoulli") theories; default Vlasov and Timoshenko (the seed's element).
 
     Returns:
         The assembled, immutable :class:`BridgeModel`.
@@ -566,6 +574,14 @@ def build_bridge(
     if len(supports) != len(spans) + 1:
         raise ConfigError(f"`supports` needs {len(spans) + 1} entries, one per support line (got {len(supports)})")
     support_sets = tuple(support_dofs(s) for s in supports)
+    theory = DEFAULT_THEORY if theory is None else theory
+    if not isinstance(theory, BeamTheory):
+        raise ConfigError(f"`theory` must be a BeamTheory (got {theory!r})")
+    if theory.torsion == "benscoter" and section.I_w > 0 and section.I_ws is None:
+        raise ConfigError(
+            'torsion = "benscoter" needs the warping shear constant `I_ws` of the section (m^4): give it with the '
+            'section constants, or describe the section by plates (which compute it), or use torsion = "vlasov"'
+        )
 
     nodes_x = _mesh(spans, n_per)
     n_nodes = len(nodes_x)
@@ -579,7 +595,7 @@ def build_bridge(
     for e, L in enumerate(lengths):
         key = round(float(L), 12)
         if key not in cache:
-            cache[key] = element_matrices(float(L), material, section)
+            cache[key] = element_matrices(float(L), material, section, theory)
         k_e, m_e = cache[key]
         dofs = NODE_DOFS * e + local
         rows.append(np.repeat(dofs, ELEMENT_DOFS))
@@ -603,6 +619,7 @@ def build_bridge(
         restrained=np.array(restrained, dtype=np.int64),
         K=K,
         M=M,
+        theory=theory,
     )
     bridge.check_no_mechanism()
     if damping is None:

@@ -79,6 +79,13 @@ class SectionProperties:
         deck_y: lateral extent (y_min, y_max) of the deck, m; sensors and wheel
             paths must lie inside it.
         source: where the constants came from (for logs and reports).
+        I_ws: warping shear constant about S, m^4 (secondary torsion stiffness
+            ``G I_ws`` of shear-deformable warping, docs/theory.md §10.2); None when
+            not known, infinite for a section without warping.
+        mass_per_length: mass per unit length, kg/m, replacing ``rho A`` in the
+            translational inertia (and its coupling with the twist); None: ``rho A``.
+        rotary_inertia: whether the bending rotations carry inertia ``rho I_y``,
+            ``rho I_z`` (False for a classical Euler-Bernoulli beam).
     """
 
     A: float
@@ -95,6 +102,9 @@ class SectionProperties:
     A_sz: float
     deck_y: tuple[float, float]
     source: str = "constants"
+    I_ws: float | None = None
+    mass_per_length: float | None = None
+    rotary_inertia: bool = True
 
     @property
     def I_ps(self) -> float:
@@ -339,6 +349,8 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
     i_xw, i_yw = np.linalg.solve(np.array([[ixy, -iyy], [ixx, -ixy]]), np.array([xs * det, ys * det]))
     gamma = float(section.get_egamma() + ((z_se - z_c) - ys) * i_xw - ((y_se - y_c) - xs) * i_yw)
     a_sx, a_sy = (float(v) for v in section.get_eas())
+    i_w = max(gamma, 0.0)
+    i_ws = _warping_shear_constant(section, (xs, ys), i_w, ixx + iyy + area * (xs**2 + ys**2))
     y_min, _, y_max, _ = polygon.bounds
     return SectionProperties(
         A=area,
@@ -351,7 +363,7 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
         z_s=z_st,
         J=float(section.get_ej()),
         # Sections with next to no warping (a thin tee or cross) can come out at -1e-18.
-        I_w=max(gamma, 0.0),
+        I_w=i_w,
         A_sy=a_sx,
         A_sz=a_sy,
         deck_y=(float(y_min), float(y_max)),
@@ -359,7 +371,98 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
             f"plates (sectionproperties FE, mesh {len(section.elements)} quadratic triangles "
             f"<= {mesh_size:.3g} m^2, nu = {nu:g})"
         ),
+        I_ws=i_ws,
     )
+
+
+#: Below this share of I_ps^2 / A the warping constant is round-off (a section without warping): I_ws is infinite.
+_NO_WARPING = 1e-12
+
+
+def _tri6_gradients(coords: np.ndarray, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Shape functions (6,), their (y, z) gradients (n_el, 2, 6) and the area factors (n_el,) of Tri6 elements.
+
+    ``coords`` (n_el, 2, 6) in the node order of sectionproperties (corners, then
+    the mid-sides 1-2, 2-3, 3-1); ``eta`` one point in area coordinates. The
+    same isoparametric map as ``sectionproperties.analysis.fea.shape_function``,
+    vectorised over the elements.
+    """
+    e1, e2, e3 = eta
+    n = np.array([e1 * (2 * e1 - 1), e2 * (2 * e2 - 1), e3 * (2 * e3 - 1), 4 * e1 * e2, 4 * e2 * e3, 4 * e3 * e1])
+    dn = np.array([[4 * e1 - 1, 0, 0], [0, 4 * e2 - 1, 0], [0, 0, 4 * e3 - 1],
+                   [4 * e2, 4 * e1, 0], [0, 4 * e3, 4 * e2], [4 * e3, 0, 4 * e1]])  # dN_i / d eta_k
+    jac = np.ones((coords.shape[0], 3, 3))
+    jac[:, 1:, :] = coords @ dn  # rows: 1, y, z against eta_k
+    det = np.linalg.det(jac)
+    # d eta / d(y, z): the last two columns of the inverse Jacobian.
+    p = np.linalg.solve(jac, np.broadcast_to(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), (len(jac), 3, 2)))
+    grad = np.einsum("ik,ekj->eji", dn, p)
+    return n, grad, 0.5 * det
+
+
+def _warping_shear_constant(section: Any, pole: tuple[float, float], i_w: float, i_ps: float) -> float:
+    """Warping shear constant ``I_ws = I_w^2 / integral |grad F|^2 dA`` on the FE section mesh (docs/theory.md §10.2).
+
+    Benscoter's warping stress ``sigma_x = -E omega psi'`` is balanced by shear
+    stresses ``tau = (T_w / I_w) grad F`` with ``laplacian F = omega`` in the
+    section and ``dF/dn = 0`` on its boundary (no traction), ``T_w`` the
+    secondary torque. Their energy ``T_w^2 / (2 G I_ws)`` defines ``I_ws`` as the
+    shear areas are defined. ``omega`` is the principal warping function about
+    the Trefftz centre: sectionproperties' Saint-Venant function (twist about
+    C) moved to that pole, less its mean. The Neumann problem is solved on the
+    solver's own quadratic triangles with the mean of ``F`` held at zero (a
+    Lagrange multiplier); 6-point quadrature integrates it exactly.
+
+    Args:
+        section: the solved ``sectionproperties`` Section.
+        pole: the Trefftz shear centre relative to the centroid, m.
+        i_w: the warping constant about that pole, m^6.
+        i_ps: the polar moment about it, m^4 (only to judge "no warping").
+
+    Returns:
+        ``I_ws`` in m^4; infinite for a section without warping.
+    """
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+    from sectionproperties.analysis.fea import gauss_points
+
+    area = float(section.get_ea())
+    if not i_w > _NO_WARPING * i_ps**2 / area:
+        return math.inf
+    cy, cz = (float(v) for v in section.get_c())
+    coords = np.array([el.coords for el in section.elements], dtype=float)  # (n_el, 2, 6)
+    coords[:, 0, :] -= cy
+    coords[:, 1, :] -= cz
+    ids = np.array([el.node_ids for el in section.elements], dtype=np.int64)  # (n_el, 6)
+    n_nodes = section.num_nodes
+    y = np.zeros(n_nodes)
+    z = np.zeros(n_nodes)
+    y[ids], z[ids] = coords[:, 0, :], coords[:, 1, :]
+    # The warping function about the pole P: omega_P = omega_C - z_P y + y_P z (then less its mean).
+    omega = np.asarray(section.section_props.omega, dtype=float) - pole[1] * y + pole[0] * z
+
+    k_el = np.zeros((len(ids), 6, 6))
+    m_el = np.zeros((len(ids), 6, 6))
+    c_el = np.zeros((len(ids), 6))
+    for gp in gauss_points(n=6):
+        n, grad, jac = _tri6_gradients(coords, gp[1:])
+        weight = gp[0] * jac
+        k_el += weight[:, None, None] * np.einsum("eki,ekj->eij", grad, grad)
+        m_el += weight[:, None, None] * np.outer(n, n)[None]
+        c_el += weight[:, None] * n[None]
+    rows, cols = np.repeat(ids, 6, axis=1).ravel(), np.tile(ids, (1, 6)).ravel()
+    stiffness = sp.csr_matrix((k_el.ravel(), (rows, cols)), shape=(n_nodes, n_nodes))
+    mass = sp.csr_matrix((m_el.ravel(), (rows, cols)), shape=(n_nodes, n_nodes))
+    ones = np.zeros(n_nodes)
+    np.add.at(ones, ids, c_el)
+    omega -= (ones @ omega) / area
+    load = mass @ omega  # integral of N_i omega dA
+    system = sp.bmat([[stiffness, ones[:, None]], [ones[None, :], None]], format="csc")
+    f = spla.spsolve(system, np.append(load, 0.0))[:-1]
+    energy = float(f @ load)  # integral of |grad F|^2 dA (F has zero mean and solves K F = load)
+    if not (math.isfinite(energy) and energy > 0):
+        raise ModelError("the section solver failed on the warping shear function (non-positive energy)")
+    return i_w**2 / energy
 
 
 section_from_plates.cache_info = _solve_fe.cache_info  # type: ignore[attr-defined]
@@ -386,6 +489,9 @@ def section_from_constants(
     A_sz: float | None = None,
     deck_y: tuple[float, float] | None = None,
     source: str = "constants",
+    I_ws: float | None = None,
+    mass_per_length: float | None = None,
+    rotary_inertia: bool = True,
 ) -> SectionProperties:
     """Section constants given directly (from a design report or another solver).
 
@@ -402,6 +508,12 @@ def section_from_constants(
             (the solid-rectangle value, so give them for thin-walled sections).
         deck_y: lateral extent (y_min, y_max) of the deck, m; required.
         source: description kept with the constants.
+        I_ws: warping shear constant about S, m^4 (needed by Benscoter torsion
+            when ``I_w > 0``); default unknown.
+        mass_per_length: mass per unit length, kg/m, replacing ``rho A`` in the
+            translational inertia; default ``rho A``.
+        rotary_inertia: False drops the inertia of the bending rotations
+            (``rho I_y``, ``rho I_z``), as a classical Euler-Bernoulli beam has none.
 
     Returns:
         The validated constants.
@@ -438,6 +550,18 @@ def section_from_constants(
         shear[name] = 5.0 / 6.0 * A if area is None else _finite(area, name)
         if not shear[name] > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {area!r})")
+    i_ws: float | None = None
+    if I_ws is not None:
+        i_ws = _finite(I_ws, "I_ws")
+        if not i_ws > 0:
+            raise ConfigError(f"`I_ws` must be > 0 m^4 (got {I_ws!r})")
+    mass: float | None = None
+    if mass_per_length is not None:
+        mass = _finite(mass_per_length, "mass_per_length")
+        if not mass > 0:
+            raise ConfigError(f"`mass_per_length` must be > 0 kg/m (got {mass_per_length!r})")
+    if not isinstance(rotary_inertia, bool):
+        raise ConfigError(f"`rotary_inertia` must be true or false (got {rotary_inertia!r})")
     if deck_y is None:
         raise ConfigError("`deck_y` is required: the lateral extent [y_min, y_max] of the deck in m")
     y_min, y_max = _point(deck_y, "deck_y", "")
@@ -446,6 +570,7 @@ def section_from_constants(
     return SectionProperties(
         A=A, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_sc, z_s=z_sc, J=J, I_w=I_w,
         A_sy=shear["A_sy"], A_sz=shear["A_sz"], deck_y=(y_min, y_max), source=str(source),
+        I_ws=i_ws, mass_per_length=mass, rotary_inertia=rotary_inertia,
     )
 
 
@@ -505,7 +630,9 @@ def thin_walled_properties(plates: Sequence[Plate]) -> SectionProperties:
     ``J = sum(b t^3 / 3)``; shear centre and ``I_w`` from the sectorial
     coordinate accumulated over the plate tree and normalised to the principal
     sectorial coordinate; shear areas from the shear-flow energy
-    ``1 / A_s = integral of q^2 / t ds`` for a unit shear force. The shear
+    ``1 / A_s = integral of q^2 / t ds`` for a unit shear force, and the warping
+    shear constant ``I_ws = I_w^2 / integral of S_w^2 / t ds`` from the sectorial
+    flow ``S_w = integral of omega t ds`` (docs/theory.md §10.2). The shear
     centre, ``I_w`` and the shear flows use midline second moments (no own
     terms), as the closed-form textbook results do.
 
@@ -605,7 +732,10 @@ def thin_walled_properties(plates: Sequence[Plate]) -> SectionProperties:
 
     def shear_area(alpha: float, beta: float) -> float:
         """1 / integral(q^2/t ds) for the shear flow of d(sigma)/dx = alpha y~ + beta z~."""
-        g = alpha * yt + beta * zt
+        return flow_stiffness(alpha * yt + beta * zt)
+
+    def flow_stiffness(g: np.ndarray) -> float:
+        """1 / integral(q^2/t ds) for the shear flow q balancing d(sigma)/dx = g, g linear on each plate."""
         below = np.zeros(n_nodes)  # integral of g dA over the subtree beyond each node
         energy = 0.0
         for k in range(len(order) - 1, -1, -1):
@@ -621,11 +751,15 @@ def thin_walled_properties(plates: Sequence[Plate]) -> SectionProperties:
     # Unit V_y: integral of g y~ dA = 1, of g z~ dA = 0 (and the reverse for V_z).
     A_sy = shear_area(*np.linalg.solve(inertia, [1.0, 0.0]))
     A_sz = shear_area(*np.linalg.solve(inertia, [0.0, 1.0]))
+    # Secondary torsion (docs/theory.md §10.2): the warping stress -E omega psi' is balanced by the flow
+    # q = (T_w / I_w) integral(omega t ds) from the free ends, whose energy defines I_ws = I_w^2 / integral(q^2/t ds).
+    i_ps = I_y + I_z + area * ((y_s - y_c) ** 2 + (z_s - z_c) ** 2)
+    I_ws = float(I_w**2 * flow_stiffness(omega_s)) if I_w > _NO_WARPING * i_ps**2 / area else math.inf
 
     corners = np.array([pt for r in rows for pt in _rectangle(*r)])
     return SectionProperties(
         A=area, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_s, z_s=z_s,
         J=float((bt * t**2 / 3).sum()), I_w=I_w, A_sy=A_sy, A_sz=A_sz,
         deck_y=(float(corners[:, 0].min()), float(corners[:, 0].max())),
-        source="thin-walled theory",
+        source="thin-walled theory", I_ws=I_ws,
     )

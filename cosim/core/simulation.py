@@ -249,6 +249,7 @@ def simulate(
     block_steps: int = 200,
     observers: Sequence[BlockObserver] = (),
     collect: bool = True,
+    overlap: bool = True,
 ) -> SimulationResult:
     """Simulate ``duration`` seconds of traffic on the bridge.
 
@@ -265,6 +266,11 @@ def simulate(
         observers: also shown every block (e.g. a log writer), in order.
         collect: keep the sampled histories in the result; without it memory
             stays constant however long the run (extremes are still reported).
+        overlap: compute the next block of traffic (SUMO, in this thread) while
+            the compiled loop, which releases the GIL, advances the bridge over
+            the current one in a worker thread: two cores work at once. The
+            numbers are the same either way (the traffic does not depend on the
+            bridge, and the blocks are advanced in order).
     """
     _finite("", "duration", duration, 0.0)
     if duration < solver.dt:
@@ -292,18 +298,39 @@ def simulate(
     empty = np.zeros((0, 0))
     system.advance(TrafficBlock((), (), empty, empty, empty, np.zeros(0)))
     started = time.perf_counter()
-    done = 0
-    while done < n_steps:
-        k = min(block_steps, n_steps - done)
-        steps = np.arange(done + 1, done + k + 1)
-        times = steps * solver.dt
-        report = system.advance(traffic.block(times))
+
+    def finish(pending: tuple[Future[BlockReport], np.ndarray, np.ndarray]) -> None:
+        future, steps, times = pending
+        report = future.result()
         keep = steps % output_every == 0
         for w in watchers:
             w.on_block(times, keep, report)
-        done += k
         if progress is not None:
-            progress(done / n_steps)
+            progress(int(steps[-1]) / n_steps)
+
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="cosim-solver") as solver_thread:
+        pending: tuple[Future[BlockReport], np.ndarray, np.ndarray] | None = None
+        try:
+            done = 0
+            while done < n_steps:
+                k = min(block_steps, n_steps - done)
+                steps = np.arange(done + 1, done + k + 1)
+                times = steps * solver.dt
+                block = traffic.block(times)  # while the worker advances the previous block
+                if pending is not None:
+                    finish(pending)
+                    pending = None
+                pending = (solver_thread.submit(system.advance, block), steps, times)
+                if not overlap:
+                    finish(pending)
+                    pending = None
+                done += k
+            if pending is not None:
+                finish(pending)
+                pending = None
+        finally:
+            if pending is not None:  # interrupted: let the block in flight end before the state is read
+                wait([pending[0]])
     if collector is not None:
         vehicle_table = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in collector.table.items()}
         vehicle_table["vehicle"] = vehicle_table["vehicle"].astype(np.int64)

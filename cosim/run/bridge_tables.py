@@ -21,6 +21,7 @@ from cosim.core.bridge import (
     RayleighDamping,
 )
 from cosim.core.bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
+from cosim.core.element import BENDING_THEORIES, TORSION_THEORIES, BeamTheory
 from cosim.core.section import (
     Material,
     Plate,
@@ -37,6 +38,7 @@ from .config_base import (
     Point,
     Positive,
     Problems,
+    choice,
     choices_message,
     describe,
     fail,
@@ -229,6 +231,9 @@ class ConstantsConfig(ConfigModel):
     A_sy: Positive | None = None
     A_sz: Positive | None = None
     deck_y: Interval
+    I_ws: Positive | None = None
+    mass_per_length: Positive | None = None
+    rotary_inertia: Annotated[bool, Strict()] = True
 
     @model_validator(mode="after")
     def _consistent(self) -> ConstantsConfig:
@@ -285,9 +290,11 @@ class SectionConfig(ConfigModel):
             return section_from_plates([p.to_plate() for p in self.plates], nu=nu, mesh_size=self.mesh_size)
         assert self.constants is not None
         c = self.constants
-        optional = {k: getattr(c, k) for k in ("y_s", "z_s", "A_sy", "A_sz") if getattr(c, k) is not None}
+        keys = ("y_s", "z_s", "A_sy", "A_sz", "I_ws", "mass_per_length")
+        optional = {k: getattr(c, k) for k in keys if getattr(c, k) is not None}
         return section_from_constants(
-            c.A, c.I_y, c.I_z, c.J, y_c=c.y_c, z_c=c.z_c, I_yz=c.I_yz, I_w=c.I_w, deck_y=c.deck_y, **optional
+            c.A, c.I_y, c.I_z, c.J, y_c=c.y_c, z_c=c.z_c, I_yz=c.I_yz, I_w=c.I_w, deck_y=c.deck_y,
+            rotary_inertia=c.rotary_inertia, **optional
         )
 
 
@@ -349,6 +356,8 @@ class BridgeConfig(ConfigModel):
     section: SectionConfig
     supports: Annotated[tuple[Union[str, tuple[str, ...]], ...], PlainValidator(_supports)]
     damping: DampingConfig | None = None
+    torsion: Annotated[str, choice(TORSION_THEORIES, "torsion theory")] = "vlasov"
+    bending: Annotated[str, choice(BENDING_THEORIES, "bending theory")] = "timoshenko"
 
     @field_validator("spans")
     @classmethod
@@ -359,7 +368,7 @@ class BridgeConfig(ConfigModel):
 
     @model_validator(mode="after")
     def _counts(self) -> BridgeConfig:
-        problems = []
+        problems: list[tuple[tuple[str, ...], str]] = []
         n = len(self.spans)
         if isinstance(self.elements_per_span, tuple) and len(self.elements_per_span) != n:
             problems.append(
@@ -370,6 +379,14 @@ class BridgeConfig(ConfigModel):
                 (("supports",), f"expected {n + 1} entries (one per support line: len(spans) + 1), "
                                 f"got {len(self.supports)}")
             )
+        constants = self.section.constants
+        if (self.torsion == "benscoter" and constants is not None and constants.I_w > 0
+                and constants.I_ws is None):
+            problems.append(
+                (("section", "constants", "I_ws"),
+                 'required by torsion = "benscoter" when I_w > 0: the warping shear constant in m^4 '
+                 "(docs/theory.md §10.2; plates compute it), or use torsion = \"vlasov\"")
+            )
         if problems:
             raise Problems(problems)
         return self
@@ -378,3 +395,7 @@ class BridgeConfig(ConfigModel):
     def length(self) -> float:
         """Total length, m."""
         return float(sum(self.spans))
+
+    def theory(self) -> BeamTheory:
+        """The element's torsion and bending theories (:class:`cosim.core.element.BeamTheory`)."""
+        return BeamTheory(torsion=self.torsion, bending=self.bending)

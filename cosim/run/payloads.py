@@ -10,7 +10,14 @@ from dataclasses import asdict
 from typing import Any
 
 from cosim.core.bridge import BridgeModel, ModalResult
+from cosim.core.element import DOF_INDEX, NODE_DOFS
 from cosim.core.section import SectionProperties
+
+#: What the mode shapes of :func:`modes_payload` hold and in which units.
+SHAPE_NOTE = (
+    "mass-normalised (phi^T M phi = 1) nodal values at nodes_x: w on the bridge axis y = 0 (w_S - y_S theta_x) "
+    "and v of the shear centre in m/sqrt(kg), theta_x in rad/sqrt(kg); the sign makes each mode's largest DOF positive"
+)
 
 
 def jsonable(value: Any) -> Any:
@@ -31,10 +38,15 @@ def section_payload(section: SectionProperties) -> dict[str, Any]:
     return jsonable(asdict(section))
 
 
-def modes_payload(modal: ModalResult) -> list[dict[str, Any]]:
-    """One entry per mode: ``n`` (1-based), ``f_hz``, ``kind`` and the effective modal mass fractions."""
+def modes_payload(modal: ModalResult, shapes: bool = False) -> list[dict[str, Any]]:
+    """One entry per mode: ``n`` (1-based), ``f_hz``, ``kind`` and the effective modal mass fractions.
+
+    With ``shapes``, each entry also has ``shape``: the nodal values (at
+    ``modal.bridge.nodes_x``) of ``w`` on the bridge axis, the twist ``theta_x``
+    and the lateral ``v``, mass-normalised (:data:`SHAPE_NOTE`).
+    """
     f_hz = modal.f_hz
-    return [
+    entries = [
         {
             "n": i + 1,
             "f_hz": float(f_hz[i]),
@@ -43,6 +55,14 @@ def modes_payload(modal: ModalResult) -> list[dict[str, Any]]:
         }
         for i in range(len(f_hz))
     ]
+    if shapes:
+        nodal = modal.shapes.reshape(modal.bridge.n_nodes, NODE_DOFS, -1)  # (node, DOF, mode)
+        w_s, twist, v = (nodal[:, DOF_INDEX[name], :] for name in ("w", "theta_x", "v"))
+        # The deck point on the axis: w(x, 0) = w_S + (0 - y_S) theta_x (docs/theory.md (1.4)), exact at the nodes.
+        w_axis = w_s - modal.bridge.section.y_s * twist
+        for i, entry in enumerate(entries):
+            entry["shape"] = {"w": w_axis[:, i].tolist(), "theta_x": twist[:, i].tolist(), "v": v[:, i].tolist()}
+    return entries
 
 
 def damping_payload(bridge: BridgeModel) -> dict[str, Any]:

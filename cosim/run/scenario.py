@@ -382,6 +382,7 @@ class Scenario(ConfigModel):
                 section=section,
                 supports=bridge.supports,
                 damping=bridge.damping.to_damping() if bridge.damping is not None else None,
+                theory=bridge.theory(),
             )
 
     @property

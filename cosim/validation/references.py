@@ -28,6 +28,12 @@ __all__ = [
     "timoshenko_ss_frequency_hz",
     "midspan_torque_twist",
     "torsional_frequencies_hz",
+    "benscoter_midspan_torque_twist",
+    "benscoter_torsional_frequencies_hz",
+    "i_section_warping_shear_constant",
+    "channel_warping_shear_constant",
+    "VBI2D_SPRUNG",
+    "vbi2d_sprung_case",
     "lateral_torsional_frequencies_hz",
     "fryba_midspan_deflection",
     "sprung_mass_modal_solution",
@@ -202,6 +208,93 @@ def torsional_frequencies_hz(
     return np.sqrt(w2) / (2 * np.pi)
 
 
+# --------------------------------------------------------------------------- shear-deformable warping (Benscoter)
+
+def benscoter_midspan_torque_twist(
+    x: npt.ArrayLike, L: float, T: float, GJ: float, EIw: float, GIws: float, warping: str
+) -> npt.NDArray[np.float64]:
+    """Twist (rad) under a mid-span torque ``T`` (N m) with shear-deformable warping (Benscoter).
+
+    Derived in docs/theory.md §10.4 from the equilibrium of the left half,
+    ``GJ theta' + G I_ws (theta' - psi) = T/2`` and ``E I_w psi'' + G I_ws (theta' - psi) = 0``
+    (Benscoter, J. Appl. Mech. 21, 1954), which give
+    ``psi'' - mu^2 psi = -mu^2 T / (2 GJ)`` with ``mu^2 = GJ G I_ws / (E I_w (GJ + G I_ws))``,
+    ``psi(L/2) = 0`` by symmetry, and::
+
+        theta = T x / (2 G_t) + (G I_ws / G_t) T / (2 GJ) I(x),   G_t = GJ + G I_ws,
+
+    with ``I = x - sinh(mu x)/mu + tanh(mu L/4) (cosh(mu x) - 1)/mu`` for warping
+    restrained ends (theta = psi = 0) and ``I = x - sinh(mu x) / (mu cosh(mu L/2))``
+    for fork ends (theta = 0, psi' = 0). ``G I_ws -> inf`` gives the Vlasov forms of
+    :func:`midspan_torque_twist`.
+    """
+    x = np.asarray(x, dtype=float)
+    s = np.minimum(x, L - x)
+    g_t = GJ + GIws
+    mu = np.sqrt(GJ * GIws / (EIw * g_t))
+    if warping == "restrained":
+        integral = s - np.sinh(mu * s) / mu + np.tanh(mu * L / 4) * (np.cosh(mu * s) - 1) / mu
+    elif warping == "free":
+        integral = s - np.sinh(mu * s) / (mu * np.cosh(mu * L / 2))
+    else:
+        raise ConfigError(f"`warping` must be 'free' or 'restrained' (got {warping!r})")
+    return T * s / (2 * g_t) + GIws / g_t * T / (2 * GJ) * integral
+
+
+def benscoter_torsional_frequencies_hz(
+    n: npt.ArrayLike, L: float, material: Material, section: SectionProperties
+) -> npt.NDArray[np.float64]:
+    """Torsional frequencies (Hz) with shear-deformable warping, fork supports, S = C (docs/theory.md §10.4).
+
+    ``theta = sin(k x)``, ``psi = cos(k x)`` (``k = n pi / L``) in the equations of
+    motion of the energies (10.1)-(10.2) give the smaller root of::
+
+        (G_t k^2 - w^2 rho I_ps)(E I_w k^2 + G I_ws - w^2 rho I_w) - (G I_ws k)^2 = 0,   G_t = GJ + G I_ws,
+
+    the torsional counterpart of Timoshenko's frequency equation (Han, Benaroya
+    & Wei 1999); ``I_ws -> inf`` gives :func:`torsional_frequencies_hz`.
+    """
+    if section.I_ws is None:
+        raise ConfigError("the section has no warping shear constant `I_ws`")
+    E, G, rho = material.E, material.G, material.rho
+    k = np.asarray(n, dtype=float) * np.pi / L
+    gj, eiw, giws = G * section.J, E * section.I_w, G * section.I_ws
+    a = rho * section.I_ps * rho * section.I_w
+    b = -(rho * section.I_ps * (eiw * k**2 + giws) + rho * section.I_w * (gj + giws) * k**2)
+    c = (gj + giws) * k**2 * (eiw * k**2 + giws) - (giws * k) ** 2
+    w2 = (-b - np.sqrt(b * b - 4 * a * c)) / (2 * a)
+    return np.sqrt(w2) / (2 * np.pi)
+
+
+def i_section_warping_shear_constant(b: float, h: float, t_f: float) -> float:
+    """``I_ws = 5/12 b t_f h^2`` (m^4) of a doubly symmetric thin-walled I-section (docs/theory.md §10.2).
+
+    Flange width ``b``, depth ``h`` between flange midlines: the secondary torque
+    ``T_w`` is carried by the flanges' lateral shear forces ``+-T_w / h``, whose
+    parabolic flows store the energy of a rectangle ``b t_f`` with the shear
+    coefficient 5/6; the web carries none.
+    """
+    return 5.0 / 12.0 * b * t_f * h**2
+
+
+def channel_warping_shear_constant(b: float, h: float, t_f: float, t_w: float) -> float:
+    """``I_ws`` (m^4) of a thin-walled channel (flanges ``b`` from the web's midline, web ``h``) (docs/theory.md §10.2).
+
+    ``I_w^2 / integral(S_w^2 / t ds)`` with the principal sectorial coordinate
+    about the shear centre ``e = 3 b^2 t_f / (6 b t_f + h t_w)`` behind the web,
+    ``I_w = t_f b^3 h^2 (3 b t_f + 2 h t_w) / (12 (6 b t_f + h t_w))``, integrated
+    in closed form over the flanges and the web::
+
+        I_ws = 5 b^2 h^2 t_f (3 b t_f + 2 h t_w)^2
+               / (3 (36 b^3 t_f^2 + 42 b^2 h t_f t_w + 16 b h^2 t_w^2 + 3 h^3 t_f t_w))
+    """
+    numerator = 5 * b**2 * h**2 * t_f * (3 * b * t_f + 2 * h * t_w) ** 2
+    denominator = 3 * (36 * b**3 * t_f**2 + 42 * b**2 * h * t_f * t_w + 16 * b * h**2 * t_w**2 + 3 * h**3 * t_f * t_w)
+    return numerator / denominator
+
+
+# --------------------------------------------------------------------------- coupled torsion
+
 def lateral_torsional_frequencies_hz(
     n_max: int, L: float, material: Material, section: SectionProperties
 ) -> npt.NDArray[np.float64]:
@@ -321,4 +414,37 @@ def yang_yau_case():
     bridge = build_bridge([p["L"]], 40, mat, sec, ["pinned", "fork"])
     car = QuarterCar(m_v=p["m_v"], m_w=0.0, k_v=p["k_v"], c_v=p["c_v"])
     traffic = ScriptedTraffic((ScriptedVehicle("S", car, 0.0, p["v"]),), p["L"])
+    return bridge, traffic, p["L"] / p["v"]
+
+
+# VBI-2D's sprung-vehicle verification case (D. Cantero, VBI-2D, github.com/DanielCanteroNTNU/VBI-2D,
+# V01_Analytical_Verification_Examples.m, "SprungVeh"):
+# L 25 m, E 3.5e10 Pa, I 1.3901 m^4, 18358 kg/m, undamped; body 5750 kg on 1.595e6 N/m, no damper and
+# no wheel mass, 25 m/s, at x = 0 at t = 0; its modal Newmark solution (100 modes, dt 1 ms) peaks at mid-span
+# at -0.41855 mm at t = 0.436 s.
+VBI2D_SPRUNG = {"L": 25.0, "E": 3.5e10, "I": 1.3901, "m": 18358.0, "m_v": 5750.0, "k_v": 1.595e6, "v": 25.0,
+                "peak_w": -0.41855e-3, "peak_t": 0.436}
+
+
+def vbi2d_sprung_case(n_el: int = 20):
+    """VBI-2D's sprung-vehicle case as a cosim model: (bridge, traffic, crossing time), Python API.
+
+    The same model as ``examples/scenarios/vbi2d-sprung-mass.toml``: Euler-Bernoulli
+    bending, the mass per length given, no rotary inertia; the body is a
+    quarter-car without wheel mass; A, J, I_z and rho only set modes this 2D case
+    does not excite.
+    """
+    from cosim.core.bridge import BeamTheory, build_bridge
+    from cosim.core.section import section_from_constants
+    from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
+    from cosim.core.vehicles import QuarterCar
+
+    p = VBI2D_SPRUNG
+    material = Material(E=p["E"], G=p["E"] / 2.4, rho=2500.0)
+    section = section_from_constants(A=7.3432, I_y=p["I"], I_z=20.0, J=2.0, mass_per_length=p["m"],
+                                     rotary_inertia=False, deck_y=(-2.5, 2.5))
+    bridge = build_bridge([p["L"]], n_el, material, section, ["pinned", "fork"],
+                          theory=BeamTheory(bending="euler-bernoulli"))
+    car = QuarterCar(m_v=p["m_v"], m_w=0.0, k_v=p["k_v"], c_v=0.0)
+    traffic = ScriptedTraffic((ScriptedVehicle("sprung", car, 0.0, p["v"]),), p["L"])
     return bridge, traffic, p["L"] / p["v"]

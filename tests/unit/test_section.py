@@ -5,6 +5,8 @@ Every reference value names its source. Tolerances are relative unless named
 """
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from cosim.core import section
@@ -16,7 +18,11 @@ from cosim.core.section import (
     thin_walled_properties,
 )
 from cosim.errors import ConfigError, ModelError
-from cosim.validation.references import rectangle_torsion_constant
+from cosim.validation.references import (
+    channel_warping_shear_constant,
+    i_section_warping_shear_constant,
+    rectangle_torsion_constant,
+)
 
 # Exact integrals of a polygon: only round-off and the FE quadrature remain.
 EXACT_REL = 1e-6
@@ -129,6 +135,12 @@ def test_doubly_symmetric_i_section() -> None:
     assert tw.A_sy == pytest.approx(a_sy, rel=THEORY_REL)
     assert fe.A_sz == pytest.approx(a_sz, rel=THIN_REL)
     assert fe.A_sy == pytest.approx(a_sy, rel=THIN_REL)
+    # Warping shear constant (docs/theory.md §10.2): the flanges carry the secondary torque as lateral shear
+    # T_w / h with the parabolic flow of a b t rectangle, so I_ws = 5/12 b t h^2 (the web carries none). The FE
+    # value solves laplacian F = omega on the real polygon: an independent computation.
+    i_ws = i_section_warping_shear_constant(b, h, t)
+    assert tw.I_ws == pytest.approx(i_ws, rel=THEORY_REL)
+    assert fe.I_ws == pytest.approx(i_ws, rel=THIN_REL)
 
 
 def test_channel_shear_centre_and_warping_constant() -> None:
@@ -148,6 +160,18 @@ def test_channel_shear_centre_and_warping_constant() -> None:
     # Symmetric about z = 0.
     assert fe.z_s == pytest.approx(0.0, abs=SYMMETRY_ABS)
     assert fe.I_yz == pytest.approx(0.0, abs=EXACT_REL * fe.I_y)
+    # Warping shear constant: I_w^2 / integral(S_w^2 / t ds), integrated by hand over the flanges and the web
+    # (docs/theory.md §10.2), against the tree integration of thin-walled theory and the FE Neumann problem.
+    i_ws = channel_warping_shear_constant(b, h, t_f, t_w)
+    assert tw.I_ws == pytest.approx(i_ws, rel=THEORY_REL)
+    assert fe.I_ws == pytest.approx(i_ws, rel=THIN_REL)
+
+
+def test_a_section_without_warping_has_no_secondary_torsion() -> None:
+    """A tee's midlines meet at one point: omega = 0, I_w = 0 (round-off) and I_ws infinite (Benscoter = Vlasov)."""
+    tee = [Plate((-0.5, 0.0), (0.5, 0.0), 0.02), Plate((0.0, 0.0), (0.0, -0.6), 0.02)]
+    tw = thin_walled_properties(tee)
+    assert tw.I_w < 1e-30 and tw.I_ws == math.inf
 
 
 # --- the paper's double-tee ------------------------------------------------
@@ -265,6 +289,7 @@ def test_constants_defaults_and_validation() -> None:
     assert isinstance(sec, SectionProperties)
     assert (sec.y_s, sec.k_y, sec.k_z) == pytest.approx((0.0, 5 / 6, 5 / 6))
     assert sec.source == "constants"
+    assert (sec.I_ws, sec.mass_per_length, sec.rotary_inertia) == (None, None, True)
     bad = [
         (dict(A=0.0), "`A` must be > 0"),
         (dict(J=-1.0), "`J` must be > 0"),
@@ -274,6 +299,9 @@ def test_constants_defaults_and_validation() -> None:
         (dict(deck_y=(6.0, -6.0)), "`deck_y` must be ordered"),
         (dict(deck_y=None), "`deck_y` is required"),
         (dict(I_y=float("inf")), "`I_y` must be finite"),
+        (dict(I_ws=0.0), "`I_ws` must be > 0 m\\^4"),
+        (dict(mass_per_length=-1.0), "`mass_per_length` must be > 0 kg/m"),
+        (dict(rotary_inertia=0), "`rotary_inertia` must be true or false"),
     ]
     for change, message in bad:
         kwargs = dict(A=4.8, I_y=1.6, I_z=65.0, J=0.15, deck_y=(-6.655, 6.655)) | change

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from _beams import STEEL, rectangle
 
-from cosim.core.bases import DirectBasis, make_basis
+from cosim.core.bases import DirectBasis
 from cosim.core.bridge import build_bridge
 from cosim.core.coupling import CoupledSystem
 from cosim.core.schemes import Scheme

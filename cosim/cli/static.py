@@ -1,0 +1,51 @@
+"""``cosim static``: the deck's static displacements under point loads anywhere on it (a table or JSON)."""
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from cosim.core.bridge import PointLoad
+from cosim.run.payloads import jsonable
+from cosim.run.scenario import load_scenario
+from cosim.run.static import STATIC_UNITS, static_response
+
+from .text import print_lines, scenario_line
+
+
+def cmd_static(args: argparse.Namespace) -> int:
+    """Solve the scenario's bridge under the ``--load`` point loads together; print the deck displacements."""
+    scenario = load_scenario(args.scenario)
+    loads = [PointLoad(x=x, y=y, Fz=fz) for x, y, fz in args.load]
+    bridge = scenario.build_bridge()
+    response = static_response(scenario, bridge, loads)
+    if args.json:
+        payload = {
+            "scenario": scenario.title,
+            "source": scenario.source,
+            "theory": {"torsion": bridge.theory.torsion, "bending": bridge.theory.bending},
+            **response,
+            "units": STATIC_UNITS,
+        }
+        print(json.dumps(jsonable(payload), indent=2))
+        return 0
+    print(scenario_line(scenario))
+    print_lines(static_lines(response))
+    return 0
+
+
+def static_lines(response: dict[str, Any]) -> list[str]:
+    """The loads and the sensors with the deck displacement at each, in mm (positive up)."""
+    rows = [(f"load {i}", "", p["x"], p["y"], f"{p['Fz'] / 1e3:.6g} kN", p["w"], None)
+            for i, p in enumerate(response["loads"], start=1)]
+    rows += [(s["name"], s["quantity"], s["x"], s["y"], "", s["w"], s.get("bending_moment"))
+             for s in response["sensors"]]
+    width = max(len(r[0]) for r in rows) + 2
+    lines = ["Static point loads, acting together; deck displacement w [mm], positive up",
+             f"  {'point':<{width}}{'quantity':<16}{'x [m]':>9}{'y [m]':>9}{'Fz':>14}{'w [mm]':>14}{'M [kN m]':>14}"]
+    for name, quantity, x, y, force, w, moment in rows:
+        moment_text = f"{moment / 1e3:14.4f}" if moment is not None else f"{'':>14}"
+        lines.append(f"  {name:<{width}}{quantity:<16}{x:9.3f}{y:9.3f}{force:>14}{1e3 * w:14.4f}{moment_text}")
+    if not response["sensors"]:
+        lines.append("  (the scenario has no [[sensors]]: only the load points are reported)")
+    return lines
