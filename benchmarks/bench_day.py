@@ -1,0 +1,205 @@
+"""A day of traffic: co-simulation against SUMO alone, real-time factors, step costs, memory (run on demand).
+
+    python benchmarks/bench_day.py [--hours 1] [--reps 1] [--out benchmarks/results/day.md]
+    python benchmarks/bench_day.py --hours 24 --only direct+log     # the 24 h run whose figures are committed
+
+Side by side in one run, on the default run's config (`cosim run` with no
+arguments: the paper bridge under medium SUMO traffic, class A road, dt = 5 ms,
+log at 100 Hz), for the chosen number of simulated hours:
+
+- SUMO alone: the same config, step and subscriptions (`SumoTraffic.advance`
+  for every SUMO step, no bridge);
+- the co-simulation with the direct (full FE) and the modal (30 modes) basis,
+  with and without the MCAP log, through the same code as `cosim run`
+  (`run_logged` with the log; `simulate` in constant memory without);
+- the real-time factor of direct + log at dt = 5 ms and 1 ms;
+- wall time, the ratio to SUMO alone, peak memory (max RSS) and log size.
+
+Each configuration runs in its own process (libsumo is a per-process
+singleton); ratios come from the same run, so machine speed cancels. Then,
+in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
+deck for both bases (benchmarks/bench_step.py's set-up), and OpenSeesPy per
+step with 8 moving forces when it is installed (`pip install '.[bench]'`).
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+HERE = Path(__file__).resolve().parent
+RUNS = ("sumo", "direct", "direct+log", "modal", "modal+log", "direct+log@1ms")
+DEFAULT_OUT = HERE / "results" / "day.md"
+
+WORKER = r"""
+import json, resource, sys, tempfile, time, tomllib
+from pathlib import Path
+from cosim.run.scenario import load_scenario, parse_scenario
+from cosim.run.toml_writer import toml_dumps
+
+mode, hours = sys.argv[1], float(sys.argv[2])
+duration = 3600.0 * hours
+base = load_scenario("paper-bridge-traffic")
+data = tomllib.loads(base.text)
+data["traffic"]["end"] = duration
+basis = mode.split("+")[0]
+if basis in ("direct", "modal"):
+    data["solver"]["basis"] = basis
+    if basis == "modal":
+        data["solver"]["modes"] = 30
+if mode.endswith("@1ms"):
+    data["solver"]["dt"] = 0.001
+scenario = parse_scenario(toml_dumps(data), f"bench-{mode}", base_dir=base.base_dir)
+bridge = scenario.build_bridge()
+# Compile (or load) the kernels outside the timed part.
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import simulate
+from cosim.core.traffic import ScriptedTraffic
+simulate(bridge, ScriptedTraffic((), bridge.length), 0.05, scenario.solver_settings(), [Sensor("s", 1.0)])
+out = {"log_bytes": 0}
+started = time.perf_counter()
+if mode == "sumo":
+    from cosim.run.simulate import build_traffic
+    with build_traffic(scenario) as traffic:
+        for _ in range(int(round(duration / scenario.traffic.step))):
+            traffic.advance()
+elif mode.endswith("+log") or "+log@" in mode:
+    from cosim.run.logged import run_logged
+    path = Path(tempfile.mkdtemp()) / "run.mcap"
+    outcome = run_logged(scenario, path, bridge=bridge)
+    out["log_bytes"] = outcome.log_bytes
+    out["vehicles"] = len({v.split("#")[0] for v in outcome.on_deck})
+else:
+    from cosim.run.simulate import build_traffic
+    with build_traffic(scenario) as traffic:
+        res = simulate(bridge, traffic, duration, scenario.solver_settings(), scenario.sensors_core(),
+                       road=scenario.build_road(), output_every=scenario.output_every, collect=False)
+    out["vehicles"] = len({v.split("#")[0] for v in res.vehicle_ids})
+out["wall"] = time.perf_counter() - started
+out["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+print(json.dumps(out))
+"""
+
+
+def run_one(mode: str, hours: float) -> dict:
+    env = dict(os.environ)
+    out = subprocess.run([sys.executable, "-c", WORKER, mode, str(hours)], capture_output=True, text=True,
+                         check=False, env=env)
+    if out.returncode != 0:
+        tail = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"exit {out.returncode}"
+        return {"error": tail}
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def step_costs(reps: int) -> list[tuple[str, int, float]]:
+    """Microseconds of process time per step, paper bridge, quarter-cars on the deck (bench_step's set-up)."""
+    sys.path.insert(0, str(HERE))
+    import bench_step as bs
+
+    from cosim.core.vehicles import QuarterCar
+
+    paper = bs.paper_bridge()
+    qc = QuarterCar(1000.0, 100.0, 39478.4, 5026.55)
+    steps = 2000
+    rows = []
+    for basis, modes in (("direct", None), ("modal", 30)):
+        make, _ = bs.cosim_factory(paper, basis, modes)
+        for q in (0, 1, 8, 16, 64):
+            block = bs.fleet(q, qc, steps, paper.length)
+            make().advance(block)  # compile / warm up
+            best = float("inf")
+            for _ in range(reps):
+                system = make()
+                t0 = time.process_time()
+                system.advance(block)
+                best = min(best, time.process_time() - t0)
+            rows.append((basis if modes is None else f"{basis}-{modes}", q, 1e6 * best / steps))
+    return rows
+
+
+def opensees_cost() -> float | None:
+    """OpenSeesPy microseconds per step with 8 moving forces (bench_step's model), or None without it."""
+    sys.path.insert(0, str(HERE))
+    import bench_step as bs
+
+    ops = bs.import_opensees()
+    if ops is None:
+        return None
+    from cosim.core.vehicles import MovingForce
+
+    paper = bs.paper_bridge()
+    block = bs.fleet(8, MovingForce(1100.0), 500, paper.length)
+    mid = bs.opensees_build(ops, paper)
+    t0 = time.perf_counter()
+    bs.opensees_run(ops, paper, block, mid)
+    return 1e6 * (time.perf_counter() - t0) / 500
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--hours", type=float, default=1.0, help="simulated hours per run (default 1)")
+    ap.add_argument("--reps", type=int, default=1, help="repetitions of each run, the best counts (default 1)")
+    ap.add_argument("--only", nargs="*", choices=RUNS, help="only these runs (SUMO alone is always run)")
+    ap.add_argument("--skip-steps", action="store_true", help="leave out the per-step costs and OpenSeesPy")
+    ap.add_argument("--out", type=Path, default=DEFAULT_OUT)
+    args = ap.parse_args(argv)
+    runs = ["sumo", *[r for r in RUNS if r != "sumo" and (not args.only or r in args.only)]]
+    started = datetime.datetime.now()
+    best: dict[str, dict] = {}
+    for _ in range(args.reps):
+        for mode in runs:
+            r = run_one(mode, args.hours)
+            print(mode, r, flush=True)
+            if "error" in r or mode not in best or r["wall"] < best[mode].get("wall", float("inf")):
+                best[mode] = r
+    sim = 3600.0 * args.hours
+    sumo = best["sumo"].get("wall")
+    lines = [
+        f"# A day of traffic: {args.hours:g} simulated hour(s) of the default run",
+        "",
+        f"{started:%Y-%m-%d %H:%M}, {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"Python {platform.python_version()}; load average before: {os.getloadavg()[0]:.2f}.",
+        "Paper bridge, medium SUMO demand (bundled), class A road, SUMO step 0.05 s, dt = 5 ms unless noted, "
+        "log at 100 Hz; each run in its own process; best of "
+        f"{args.reps}.",
+        "",
+        "| run | wall [s] | real-time factor | / SUMO alone | peak memory [MB] | log [MB] | vehicles |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for mode in runs:
+        r = best[mode]
+        if "error" in r:
+            lines.append(f"| {mode} | failed: {r['error']} | | | | | |")
+            continue
+        ratio = f"{r['wall'] / sumo:.2f}" if sumo else "-"
+        log_mb = f"{r['log_bytes'] / 1e6:.1f}" if r.get("log_bytes") else ""
+        lines.append(f"| {mode} | {r['wall']:.1f} | {sim / r['wall']:.0f} | {ratio} | {r['max_rss_mb']:.0f} | "
+                     f"{log_mb} | {r.get('vehicles', '')} |")
+    if not args.skip_steps:
+        lines += ["", "## Microseconds per step (process time, paper bridge, quarter-cars on the deck)", "",
+                  "| basis | 0 | 1 | 8 | 16 | 64 |", "|---|---|---|---|---|---|"]
+        costs = step_costs(reps=3)
+        for basis in dict.fromkeys(b for b, _, _ in costs):
+            lines.append(f"| {basis} | " + " | ".join(f"{c:.1f}" for b, _, c in costs if b == basis) + " |")
+        ops = opensees_cost()
+        lines += ["", f"OpenSeesPy, 8 moving forces: {ops:.0f} us/step" if ops is not None else
+                  "", "OpenSeesPy: not installed (pip install '.[bench]')" if ops is None else ""]
+    text = "\n".join(lines).rstrip() + "\n"
+    print(text)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    args.out.write_text(text, encoding="utf-8")
+    print(f"written: {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
