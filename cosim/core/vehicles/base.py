@@ -17,6 +17,7 @@ are the HHT ``F_n`` of the vehicle). Parameters: a column of ``params``
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 from cosim.errors import ConfigError
 
@@ -42,3 +43,16 @@ def check_non_negative(owner: str, **values: float) -> None:
     for name, value in values.items():
         if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
             raise ConfigError(f"{owner}: `{name}` must be a finite number >= 0 (got {value!r})")
+
+
+class OneContact:
+    """What a one-contact-point model shares: its contact is the vehicle's reference point (no axles behind it)."""
+
+    KIND: ClassVar[int]
+    contacts: ClassVar[int] = 1
+    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
+
+    @property
+    def kernel_kind(self) -> int:
+        """The kind id the compiled loop dispatches on."""
+        return self.KIND

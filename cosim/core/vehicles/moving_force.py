@@ -8,11 +8,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from .base import MOVING_FORCE, check_positive
+from .base import MOVING_FORCE, OneContact, check_positive
 
 
 @dataclass(frozen=True)
-class MovingForce:
+class MovingForce(OneContact):
     """A constant vertical force ``mass * g`` moving with the vehicle.
 
     Args:
@@ -22,13 +22,6 @@ class MovingForce:
     mass: float
     kind: ClassVar[str] = "moving-force"
     KIND: ClassVar[int] = MOVING_FORCE
-    contacts: ClassVar[int] = 1
-    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
-
-    @property
-    def kernel_kind(self) -> int:
-        """Compiled kind."""
-        return self.KIND
 
     def __post_init__(self) -> None:
         check_positive("moving force", mass=self.mass)

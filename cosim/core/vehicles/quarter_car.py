@@ -14,11 +14,11 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ..jit import compiled
-from .base import QUARTER_CAR, check_non_negative, check_positive
+from .base import QUARTER_CAR, OneContact, check_non_negative, check_positive
 
 
 @dataclass(frozen=True)
-class QuarterCar:
+class QuarterCar(OneContact):
     """The paper's quarter-car with perfect wheel-deck contact.
 
     Args:
@@ -34,13 +34,6 @@ class QuarterCar:
     c_v: float
     kind: ClassVar[str] = "quarter-car"
     KIND: ClassVar[int] = QUARTER_CAR
-    contacts: ClassVar[int] = 1
-    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
-
-    @property
-    def kernel_kind(self) -> int:
-        """Compiled kind."""
-        return self.KIND
 
     def __post_init__(self) -> None:
         check_positive("quarter-car", m_v=self.m_v, k_v=self.k_v)

@@ -13,12 +13,12 @@ import numpy as np
 from cosim.errors import ConfigError
 
 from ..jit import compiled
-from .base import LINEAR, TYRE_QUARTER_CAR, check_non_negative, check_positive
+from .base import LINEAR, TYRE_QUARTER_CAR, OneContact, check_non_negative, check_positive
 from .half_car import tyre_quarter_car_system
 
 
 @dataclass(frozen=True)
-class TyreQuarterCar:
+class TyreQuarterCar(OneContact):
     """Quarter-car with a tyre spring and damper (wheel as its own DOF).
 
     Args:
@@ -38,8 +38,6 @@ class TyreQuarterCar:
     unilateral: bool = False
     kind: ClassVar[str] = "tyre-quarter-car"
     KIND: ClassVar[int] = TYRE_QUARTER_CAR
-    contacts: ClassVar[int] = 1
-    contact_offsets: ClassVar[tuple[float, ...]] = (0.0,)
 
     def __post_init__(self) -> None:
         check_positive("tyre quarter-car", m_v=self.m_v, m_w=self.m_w, k_v=self.k_v, k_t=self.k_t)
