@@ -51,6 +51,9 @@ PLOTTERS: dict[type, Callable[..., Path]] = {
     cases.RoughnessFigure: plots.validation_roughness,
     cases.MeshFigure: plots.validation_mesh,
     cases.ParkedFigure: plots.validation_parked,
+    cases.BenscoterFigure: plots.validation_benscoter,
+    cases.PaperTheoriesFigure: plots.validation_paper_theories,
+    cases.Vbi2dFigure: plots.validation_vbi2d,
 }
 
 
