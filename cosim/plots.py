@@ -9,8 +9,9 @@ from __future__ import annotations
 import itertools
 import os
 import re
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -503,7 +504,7 @@ def validation_mesh(
         n, err = np.asarray(n), np.asarray(err, dtype=float)
         ax.loglog(n, err, "o-", color=f"C{k}", ms=4, label=label)
         ax.loglog(n, err[0] * (n / n[0]) ** -order, "--", color=f"C{k}", lw=0.8, label=f"slope {order:g}")
-    _validation_log_ticks(ax, sorted({int(n) for group in counts for n in group}))
+    _validation_log_ticks(ax, sorted({int(n) for group in counts for n in np.asarray(group)}))
     ax.set_xlabel("elements in the span [-]")
     ax.set_ylabel("relative error of the first vertical frequency [-]")
     ax.set_title(title, fontsize=10)

@@ -22,8 +22,8 @@ module; cases without a tolerance are informational.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -235,7 +235,8 @@ def paper_case(dt: float) -> StudyResult:
     events = ((PAPER_QC2_ENTRY, "QC-2 on"), (bridge.length / PAPER_SPEED, "QC-1 off"),
               (PAPER_QC2_ENTRY + bridge.length / PAPER_SPEED, "QC-2 off"))
     t = res["qc"]["t"]
-    cases, figures = [], []
+    cases: list[CaseResult] = []
+    figures: list[FigureData] = []
     for i, (node, y) in enumerate(PAPER_NODES):
         w_qc, w_modal, w_mf = res["qc"][node], res["qc_modal"][node], res["mf"][node]
         peak = float(np.max(np.abs(w_qc)))
@@ -438,7 +439,7 @@ def torsion_static() -> StudyResult:
     x_fine = np.linspace(0.0, L, 401)
     file = "torsion_static.png"
     lam = math.sqrt(G * sec.J / (E * sec.I_w))
-    results, closed, fes, nodes_x = [], [], [], None
+    results, closed, fes = [], [], []
     for warping, supports in (("free", ["pinned", "fork"]), ("restrained", ["rigid-end", "rigid-end"])):
         bridge = build_bridge([L], n_el, STEEL, sec, supports)
         f = np.zeros(bridge.ndof)
@@ -448,11 +449,10 @@ def torsion_static() -> StudyResult:
         results.append((warping, _rel_peak(fe, ref), fe[n_el // 2], ref[n_el // 2]))
         closed.append(midspan_torque_twist(x_fine, L, T, G * sec.J, E * sec.I_w, warping))
         fes.append(fe)
-        nodes_x = bridge.nodes_x
     figure = TorsionStaticFigure(
         file=file, title=f"Torque {T / 1e3:g} kN m at mid-span, L = {L:g} m, λL = {lam * L:.2f}",
         x=x_fine, uniform=T * np.minimum(x_fine, L - x_fine) / (2 * G * sec.J), warping=("free", "restrained"),
-        closed=tuple(closed), nodes_x=nodes_x, fe=tuple(fes),
+        closed=tuple(closed), nodes_x=bridge.nodes_x, fe=tuple(fes),
     )
     cases = []
     for warping, error, fe_mid, ref_mid in results:
@@ -703,7 +703,7 @@ def energy_conservation(steps: int) -> StudyResult:
     file = "energy_drift.png"
     figure = EnergyFigure(
         file=file, title="Undamped free vibration of a 20 m beam (40 elements, direct basis, Newmark, dt = 1 ms)",
-        tolerance=TOL_ENERGY, t=dt * np.arange(0, steps + 1), kinetic=kinetic, strain=strain,
+        tolerance=TOL_ENERGY, t=dt * np.arange(0, steps + 1, dtype=np.float64), kinetic=kinetic, strain=strain,
         drift=np.concatenate([[0.0], drift]),
     )
     return StudyResult((CaseResult(
@@ -738,7 +738,7 @@ def time_step_convergence() -> StudyResult:
     duration, ref_steps = 0.4, 12800
     steps = np.array([100, 200, 400, 800, 1600])
     asymptotic = steps >= 400  # the orders judged: 400 -> 800 -> 1600 steps
-    combos = [
+    combos: list[tuple[str, VehicleModel, Scheme]] = [
         ("quarter-car", QuarterCar(2e4, 2e3, 2e6, 5e4), Scheme.newmark()),
         ("quarter-car", QuarterCar(2e4, 2e3, 2e6, 5e4), Scheme.hht(-0.1)),
         ("tyre quarter-car", TyreQuarterCar(2e4, 2e3, 2e6, 5e4, 2e7, 0.0), Scheme.newmark()),
@@ -803,7 +803,7 @@ def iso8608_roughness(length: float) -> StudyResult:
     from cosim.core.roughness import N0, N_MAX, N_MIN, averaged_psd, iso8608_band, iso8608_gd0, iso8608_profile
 
     # Third-octave bands over the classification range of ISO 8608 (0.011 to 2.83 cycle/m).
-    edges = 0.011 * 2.0 ** (np.arange(0, 25) / 3.0)
+    edges = (0.011 * 2.0 ** (np.arange(0, 25) / 3.0)).tolist()
     file = "roughness_psd.png"
     cases, classes, seeds, gd0s, bands, centres_all, psds = [], [], [], [], [], [], []
     for road_class, seed in (("A", 1), ("C", 2)):
@@ -1049,8 +1049,8 @@ def benscoter_torsion() -> StudyResult:
                 **{f"error_{n}_elements": e for n, e in zip(counts, errors)}},
     ))
     figure = BenscoterFigure(
-        file=file, static_title=f"Torque {T / 1e3:g} kN m at mid-span, L = {L:g} m", x=x_fine,
-        warping=tuple(warpings), closed=tuple(closed), vlasov=tuple(vlasov_lines), nodes_x=bridge.nodes_x, fe=tuple(fes),
+        file=file, static_title=f"Torque {T / 1e3:g} kN m at mid-span, L = {L:g} m", x=x_fine, warping=tuple(warpings),
+        closed=tuple(closed), vlasov=tuple(vlasov_lines), nodes_x=bridge.nodes_x, fe=tuple(fes),
         frequency_title="Fork supports", modes=modes, f_vlasov=vlasov_f, f_ref=ref_f, f_fe=fe_f, n_elements=n_el,
         mesh_label="third torsional frequency", counts=counts, errors=errors, expected_order=2.0,
     )
