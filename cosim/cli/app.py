@@ -30,7 +30,7 @@ import sys
 import textwrap
 
 from cosim import __version__
-from cosim.errors import CosimError
+from cosim.errors import CosimError, interruption
 from cosim.log.schemas import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
 from cosim.plots import MAX_MODE_SHAPES
 from cosim.run.export import EXPORT_TOPICS
@@ -41,7 +41,7 @@ from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
 from .study import cmd_study
-from .text import EXIT_INTERRUPTED, EXIT_USAGE, report_error
+from .text import EXIT_USAGE, report_error
 from .validate import cmd_validate
 
 
@@ -128,6 +128,7 @@ def build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--plot", metavar="FILE.png",
                        help=f"draw the first N (at most {MAX_MODE_SHAPES}) mode shapes: v, w and twist theta_x "
                             "along x, each normalised")
+    modes.add_argument("--force", "-f", action="store_true", help="overwrite the --plot figure if it exists")
     modes.set_defaults(func=cmd_modes)
 
     run = commands.add_parser(
@@ -181,7 +182,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="also write the sensor channels as CSV, columns t,<sensor names> (default: [output].csv "
                           "if given); the same as 'cosim export LOG --csv OUT.csv' after the run")
     run.add_argument("--force", "-f", action="store_true",
-                     help="overwrite the log and the CSV if they exist (default: refuse)")
+                     help="overwrite the log, the CSV or the summary if they exist (default: refuse; never "
+                          "the scenario or its input files)")
     run.add_argument("--quiet", "-q", action="store_true",
                      help="no progress display on stderr")
     run.set_defaults(func=cmd_run)
@@ -304,6 +306,8 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--out", default="validation", metavar="DIR",
                           help="folder for report.md and the plots (default: validation)")
     validate.add_argument("--quick", action="store_true", help="coarser settings (seconds instead of a minute)")
+    validate.add_argument("--force", "-f", action="store_true",
+                          help="replace the report (and plots) in DIR if it has one (default: refuse)")
     validate.set_defaults(func=cmd_validate)
 
     study = commands.add_parser(
@@ -364,9 +368,13 @@ def main(argv: list[str] | None = None) -> int:
     except CosimError as exc:
         report_error(str(exc))
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("cosim: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:  # SIGINT, SIGTERM or SIGHUP where the command did not report it itself
+        signum, name = interruption(exc)
+        try:
+            print(f"cosim: interrupted ({name})", file=sys.stderr)
+        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
+            pass
+        return 128 + signum
     except BrokenPipeError:  # e.g. `cosim modes ... | head`
         try:
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - silence the flush at exit

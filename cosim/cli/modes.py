@@ -6,7 +6,8 @@ import json
 
 from cosim import plots
 from cosim.run.figures import plot_modes
-from cosim.run.outputs import check_writable
+from cosim.run.inputs import scenario_files
+from cosim.run.outputs import check_not_input, check_writable
 from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
 from cosim.run.scenario import load_scenario
 
@@ -15,9 +16,10 @@ from .text import damping_lines, modes_lines, print_lines, scenario_line, sectio
 
 def cmd_modes(args: argparse.Namespace) -> int:
     """Print the modes of a scenario's bridge (``--json``: only JSON); ``--plot`` draws the first shapes."""
-    if args.plot:
-        check_writable(args.plot, "plot", plots.figure_formats())
     scenario = load_scenario(args.scenario)
+    if args.plot:
+        check_not_input(args.plot, "plot", scenario_files(scenario))
+        check_writable(args.plot, "plot", plots.figure_formats(), force=args.force)
     bridge = scenario.build_bridge()
     modal = bridge.modes(count=args.count)
     if args.json:
