@@ -26,6 +26,8 @@ def main(argv: list[str] | None = None) -> int:
     previous = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
     try:
         install_stop_handlers()
+        # ``python -m cosim`` blocks them until the handlers are in place; a pending one arrives now.
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(STOP_SIGNALS))
         from .app import main as app_main
 
         return app_main(argv)

@@ -116,7 +116,11 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
 
 
 class Progress:
-    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise."""
+    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise.
+
+    It appears with the first block of time steps: a run refused while it is
+    being set up (bad input, a limit, SUMO) prints its one error line alone.
+    """
 
     def __init__(self, duration: float, show: bool) -> None:
         self.duration = duration
@@ -124,21 +128,25 @@ class Progress:
         self._stream = sys.stderr
         self._bar: Any = None
         self._tenths: int | None = None  # the light form: tenths printed so far
-        if not show:
-            return
+        self._show = show
+
+    def _start(self) -> None:
+        self._show = False
         if self._stream.isatty():
             from tqdm import tqdm
 
             self._bar = tqdm(
-                total=duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
+                total=self.duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
                 bar_format="{desc} {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]",
             )
         else:
             self._tenths = 0
-            print(f"Simulating {duration:g} s:", end="", file=self._stream, flush=True)
+            print(f"Simulating {self.duration:g} s:", end="", file=self._stream, flush=True)
 
     def __call__(self, fraction: float) -> None:
         self.fraction = fraction
+        if self._show:
+            self._start()
         if self._bar is not None:
             self._bar.update(min(fraction * self.duration, self.duration) - self._bar.n)
         elif self._tenths is not None:

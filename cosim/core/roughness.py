@@ -181,7 +181,8 @@ def profile_from_csv(path: str | Path) -> RoadProfile:
         text = "\0"
     if "\0" in text:
         raise ConfigError(f"{path}: not a text file; a road profile is a CSV of 'x, r' lines (m, m)")
-    xs, rs = [], []
+    xs: list[float] = []
+    rs: list[float] = []
     header_seen = False
     for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or not "".join(row).strip() or row[0].strip().startswith("#"):

@@ -159,7 +159,7 @@ def _sensor_check(value: Any) -> str | None:
     return None
 
 
-_COMPILED: dict[str, Check] = {
+_COMPILED: dict[str, Callable[..., str | None]] = {
     TOPIC_SENSORS: _sensor_check,
     TOPIC_VEHICLES: compile_schema(VEHICLES_SCHEMA),
     TOPIC_EVENTS: compile_schema(EVENTS_SCHEMA),
@@ -169,6 +169,6 @@ _COMPILED: dict[str, Check] = {
 }
 
 
-def message_check(topic: str) -> Check | None:
+def message_check(topic: str) -> Callable[..., str | None] | None:
     """The check of a cosim topic's messages, or None for a topic cosim does not write (not read either)."""
     return _COMPILED.get(topic)

@@ -136,12 +136,13 @@ def _parse(path: Path, opcode: int, body: bytes, offset: int) -> Any:
             raise _corrupt(path, f"a message record at offset {offset} is too short")
         channel_id, _, log_time, _ = _MESSAGE_HEAD.unpack_from(body)
         return _Message(channel_id, log_time, body[_MESSAGE_HEAD.size:])
-    reader = {Opcode.HEADER: Header, Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.METADATA: Metadata,
-              Opcode.DATA_END: DataEnd}.get(opcode)
+    readers: dict[int, Any] = {Opcode.HEADER: Header, Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel,
+                               Opcode.METADATA: Metadata, Opcode.DATA_END: DataEnd}
+    reader = readers.get(opcode)
     if reader is None:
         return None
     try:
-        return reader.read(ReadDataStream(io.BytesIO(body)))  # type: ignore[attr-defined]
+        return reader.read(ReadDataStream(io.BytesIO(body)))
     except Exception:  # noqa: BLE001 - any parse failure of a whole record is damage
         raise _corrupt(path, f"a malformed {reader.__name__} record at offset {offset}") from None
 
@@ -185,7 +186,7 @@ def _chunk_records(path: Path, body: bytes, offset: int, number: int) -> bytes:
         elif chunk.compression == "":
             data = chunk.data
         elif chunk.compression == "lz4":
-            import lz4.frame  # type: ignore[import-not-found]  # only if installed: cosim writes zstd
+            import lz4.frame  # only if installed: cosim writes zstd
 
             decompressor = lz4.frame.LZ4FrameDecompressor()
             data = decompressor.decompress(chunk.data, max_length=size)

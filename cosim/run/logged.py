@@ -370,14 +370,14 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
     except KeyboardInterrupt as exc:
         guard.closing = True
         signum, name = interruption(exc)
-        if not state["started"]:
+        if not state["started"] or rec is None:
             discard()
             raise RunInterrupted(signum, name, None) from None
         rec.close("interrupted", interruption_message(exc), wall_time=time.perf_counter() - wall_start)
         raise RunInterrupted(signum, name, log_path) from None
     except (CosimError, *SOLVER_FAILURES) as exc:
         guard.closing = True
-        if not state["started"]:
+        if not state["started"] or rec is None:
             discard()
             if isinstance(exc, CosimError):
                 raise
@@ -395,7 +395,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         raise RunFailed(f"{scenario.source}: {message}", log_path) from None
     except BaseException as exc:  # a defect: the log still says so, and the traceback is not hidden
         guard.closing = True
-        if not state["started"]:
+        if not state["started"] or rec is None:
             discard()
         else:
             with contextlib.suppress(Exception):

@@ -86,8 +86,8 @@ def stop_signals() -> Iterator[StopGuard]:
     try:
         yield guard
     finally:
-        for signum, old in guard._old.items():
-            signal.signal(signum, old)
+        for number, handler in guard._old.items():
+            signal.signal(number, handler)
         guard._old.clear()
     if guard.held is not None:
         raise guard.held

@@ -370,7 +370,7 @@ def check_vtype_params(config: str | os.PathLike) -> None:
         SumoError: one line naming the file, the vType and the key, with the keys it may be.
     """
     try:
-        parsed = read_config(config)
+        parsed = read_config(Path(config))
     except ConfigError:
         return
     for path in parsed.files(DEMAND_OPTIONS):
