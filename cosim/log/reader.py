@@ -749,6 +749,23 @@ class LoggedTraffic:
         self._messages = iter_messages(self.path, [TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
         self._exhausted = False
 
+    def check(self) -> int:
+        """Read every logged frame and vehicle type once, as :meth:`block` will (constant memory), so that a
+        malformed one is found before a replay writes anything; returns how many frames the log holds.
+
+        Raises:
+            LogError: a frame or vehicle type that does not match its schema, frames whose arrays differ in
+                length, go back in time, are off the step, or name a vehicle type the log does not define.
+        """
+        feed = _FrameFeed(self.path, self.length, self._feed.step)
+        for topic, message in iter_messages(self.path, [TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES]):
+            if topic == TOPIC_VEHICLE_TYPES:
+                feed.vehicle_type(message)
+            else:
+                feed.frame(message)
+                feed.traffic.forget_before(feed.traffic.last_time)
+        return feed.frames
+
     @property
     def frames_read(self) -> int:
         """Logged (non-empty) frames read so far."""

@@ -348,7 +348,10 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             partial.unlink()
 
     try:
-        rec = LogRecorder(partial, names, force=False)
+        try:
+            rec = LogRecorder(partial, names, force=False)
+        except LogError as exc:  # name the log the user asked for, not its temporary name
+            raise LogError(str(exc).replace(str(partial), str(log_path))) from None
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
         for name, data in documents.items():
             media = {".csv": "text/csv", ".toml": "application/toml", ".json": "application/json"}.get(

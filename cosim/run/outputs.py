@@ -128,6 +128,8 @@ def atomic_write(path: str | os.PathLike[str], what: str) -> Iterator[Path]:
         os.replace(partial, path)
     except OSError as exc:
         raise CosimError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+    except CosimError as exc:  # a writer's own message: it names the temporary file, the user gave ``path``
+        raise CosimError(str(exc).replace(str(partial), str(path))) from None
     finally:
         with contextlib.suppress(OSError):
             partial.unlink(missing_ok=True)

@@ -20,7 +20,7 @@ from typing import Any
 
 from cosim.errors import ConfigError, LogError
 from cosim.log.reader import LoggedTraffic, LogOverview, check_messages, iter_messages, open_log
-from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES
+from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.sumo.files import FILE_OPTIONS, read_config
 
 from .inputs import input_files
@@ -201,7 +201,7 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     record = {"log": str(overview.path), "log_scenario": overview.info.get("scenario", ""),
               "log_started": overview.info.get("started", ""), "log_status": overview.status_word}
     sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "traffic" in logged
-    check_messages(overview.path, [TOPIC_SENSORS, TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES] if sumo else [TOPIC_SENSORS])
+    check_messages(overview.path, [TOPIC_SENSORS])  # the traffic frames: LoggedTraffic.check below
     covered = covered_time(overview)
     duration: float | None = None
     if other is None:
@@ -253,7 +253,7 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     if not duration > 0:
         raise LogError(f"{overview.path}: the log covers no simulated time: nothing to replay")
     traffic = LoggedTraffic(overview.path, plan.scenario.bridge.length, step, until=duration)
-    record["traffic"] = f"{overview.counts.get(TOPIC_TRAFFIC, 0)} logged SUMO frames"
+    record["traffic"] = f"{traffic.check()} logged SUMO frames"
     return ReplayPlan(plan.scenario, overview, plan.own, record, plan.attachments, traffic, duration)
 
 

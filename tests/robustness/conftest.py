@@ -20,10 +20,11 @@ def profiled_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="session")
 def sumo_log(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A finished log of 20 s of SUMO traffic over the bundled bridge (its SUMO files embedded)."""
+    """A finished log of 80 s of SUMO traffic over the bundled bridge (its SUMO files embedded); the first
+    vehicles reach the deck after about 40 s."""
     folder = tmp_path_factory.mktemp("sumo")
     sumo_folder(folder)
-    scenario = write(folder, "sumo.toml", SUMO_SCENARIO.format(end=20.0))
+    scenario = write(folder, "sumo.toml", SUMO_SCENARIO.format(end=80.0))
     result = cosim_cli("run", str(scenario), "--out", str(folder / "run.mcap"), "--quiet", cwd=folder)
     assert result.returncode == 0, result.stderr
     return folder / "run.mcap"
