@@ -18,9 +18,9 @@ the only package that prints.
 
 Every :class:`cosim.errors.CosimError` becomes ``cosim: error: <message>`` on
 stderr and exit status 2 (as for usage errors); a :class:`cosim.errors.ModelError`
-during the time integration (the solution diverged) exits with 1 (the log then
-ends with status "error"); Ctrl-C exits with 130 (the log ends with status
-"interrupted").
+after the time stepping started (the solution diverged) exits with 1 (the log then
+ends with status "error"); SIGINT (Ctrl-C), SIGTERM and SIGHUP exit with 128 +
+the signal's number, 130, 143 and 129 (a started log ends with status "interrupted").
 """
 from __future__ import annotations
 
@@ -89,7 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
         )
         + "\n"
         + bundled_text()
-        + "\nErrors print 'cosim: error: ...' on stderr and exit with status 2.",
+        + "\nErrors print 'cosim: error: ...' on stderr and exit with status 2; SIGINT, SIGTERM and SIGHUP\n"
+        "exit with 128 + the signal's number. Limits on input sizes: docs/limits.md.",
         formatter_class=formatter,
     )
     parser.add_argument("--version", action="version", version=f"cosim {__version__}")
@@ -147,17 +148,20 @@ def build_parser() -> argparse.ArgumentParser:
             constants and frequencies embedded (a log alone is enough to run it again:
             cosim replay). Then print a summary: sensor peaks, each vehicle's contact force
             and whether it lifted off, steps, wall time, real-time factor. A progress
-            display goes to stderr. The log is finished whatever ends the run: Ctrl-C
-            leaves status "interrupted", a diverging solution status "error".
+            display goes to stderr. The log is finished whatever ends the run: Ctrl-C,
+            SIGTERM or SIGHUP leave status "interrupted", a diverging solution status
+            "error" with its likely cause. An existing file is replaced only with --force,
+            and never the scenario or its input files.
 
             Without [[vehicles]]: the modal analysis (first 10 modes) and a static load
             case, a {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once
             on the bridge axis (y = 0) and once at the left deck edge (largest y),
             with each sensor's deck displacement for both (no log).
 
-            Exit status: 0 done, 1 the solution diverged (the log ends with status
-            "error"), 2 bad input (before any file is written), 130 interrupted (Ctrl-C;
-            the log ends with status "interrupted")."""
+            Exit status: 0 done, 1 the run failed after it started (the log ends with
+            status "error"), 2 bad input, SUMO's included (nothing is written), 128 + N
+            stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (the log ends with
+            status "interrupted"; nothing is written if the run had not started)."""
         ),
         epilog=textwrap.dedent(
             f"""\
@@ -202,8 +206,9 @@ def build_parser() -> argparse.ArgumentParser:
             like a run; [output].log and [output].csv of the scenarios are not used.
 
             Exit status: 0 done, 1 the solution diverged or (own scenario) the channels
-            differ, 2 bad input (unreadable log, a vehicle off OTHER's deck, ...),
-            130 interrupted."""
+            differ, 2 bad input (unreadable or damaged log, an input file the log does not
+            hold, a vehicle off OTHER's deck, ...), 128 + N stopped by signal N (130
+            Ctrl-C, 143 SIGTERM, 129 SIGHUP)."""
         ),
         epilog=textwrap.dedent(
             """\
@@ -323,8 +328,10 @@ def build_parser() -> argparse.ArgumentParser:
             failing run is recorded in the table; the others go on. docs/studies.md
             documents the study file and the output folder.
 
-            Exit status: 0 every run ok, 1 some run failed (see the table), 2 bad input,
-            130 interrupted (the same command resumes)."""
+            Exit status: 0 every run ok, 1 some run failed (see the table), 2 bad input
+            (also: --out is another study's folder), 128 + N stopped by signal N (130
+            Ctrl-C, 143 SIGTERM, 129 SIGHUP): the runs in progress stop with finished logs,
+            the table of the completed runs is written, the same command resumes."""
         ),
         epilog=textwrap.dedent(
             """\

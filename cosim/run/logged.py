@@ -12,7 +12,6 @@ from __future__ import annotations
 import contextlib
 import datetime
 import json
-import math
 import os
 import platform
 import secrets
@@ -43,7 +42,7 @@ from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
-from .simulate import build_traffic
+from .simulate import SOLVER_FAILURES, build_traffic, likely_cause
 
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
@@ -151,10 +150,6 @@ class _StartsOnFirstBlock:
         return getattr(self.traffic, name)
 
 
-#: Exceptions of the compiled solver (numba, numpy) when non-finite values reach it: a diverged solution.
-SOLVER_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
-
-
 def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: float, given: bool,
                 modal: Any) -> None:
     """Bounds that the run itself would only hit after its log exists: time steps, the basis."""
@@ -176,26 +171,6 @@ def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: 
             solver.cutoff_hz < modal.f_hz[0]:
         raise ConfigError(f"{scenario.source}: solver.cutoff_hz: no mode below {solver.cutoff_hz:g} Hz (the first "
                           f"is at {modal.f_hz[0]:.4g} Hz); raise cutoff_hz or give modes")
-
-
-#: Vehicle parameters beyond these (SI units) are out of any road vehicle's range.
-_PLAUSIBLE = {"mass": (1.0, 1e6), "m_v": (1.0, 1e6), "m_w": (0.1, 1e5), "k_v": (1.0, 1e9), "c_v": (0.0, 1e8),
-              "k_t": (1.0, 1e10), "c_t": (0.0, 1e8)}
-
-
-def likely_cause(scenario: Scenario, road: Any, solver: Any) -> str:
-    """The likeliest reason a run diverged, from its inputs: a parameter out of range, else the step."""
-    for i, vehicle in enumerate(scenario.vehicles):
-        for key, value in vehicle.parameters.items():
-            low, high = _PLAUSIBLE.get(key, (-math.inf, math.inf))
-            if not low <= value <= high:
-                return (f"vehicles[{i}] ({vehicle.id}): {key} = {value:g} is outside any road vehicle's range "
-                        f"({low:g} to {high:g})")
-    peak = float(np.max(np.abs(road.r))) if road.r.size else 0.0
-    if not peak <= 1.0:
-        return f"road: the profile's elevations reach {peak:g} m (a road profile is a few cm at most)"
-    return (f"a parameter out of range, or a time step too large for the vehicles' and the bridge's dynamics "
-            f"(solver.dt = {solver.dt:g} s; try a smaller dt, or the modal basis with fewer modes)")
 
 
 def run_logged(

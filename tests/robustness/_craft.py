@@ -92,7 +92,7 @@ def bomb(target: Path, claimed: int = 1 << 30) -> Path:
         return struct.pack("<I", len(data)) + data
 
     header = record(0x01, string("cosim") + string("crafted"))
-    compressor = zstandard.ZstdCompressor(level=19)
+    compressor = zstandard.ZstdCompressor(level=1)
     zeros = b"\0" * (1 << 20)
     chunks = compressor.chunker(chunk_size=1 << 20)
     data = b"".join(chunk for _ in range(claimed >> 20) for chunk in chunks.compress(zeros))

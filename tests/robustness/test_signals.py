@@ -98,7 +98,7 @@ def test_a_signal_before_the_run_starts_leaves_no_log(long_folder: Path) -> None
     assert not [p for p in long_folder.iterdir() if ".part" in p.name]
 
 
-@pytest.mark.parametrize("delay", [0.25, 0.5, 1.0])
+@pytest.mark.parametrize("delay", [0.3, 1.0])
 def test_ctrl_c_during_start_up_prints_one_line(long_folder: Path, delay: float) -> None:
     """Ctrl-C while cosim imports numpy and numba, reads the scenario, builds the bridge: one line, 130.
 
@@ -134,7 +134,7 @@ def test_a_killed_replay_leaves_no_scratch_folder(long_folder: Path, tmp_path: P
 def test_a_killed_export_leaves_neither_csv_nor_temporary_file(tmp_path: Path) -> None:
     log = tmp_path / "big.mcap"
     with LogRecorder(log, ["a", "b"]) as rec:
-        times = [k * 0.01 for k in range(100_000)]
+        times = [k * 0.01 for k in range(60_000)]
         rec.write_encoded("/cosim/sensors", times, [b'{"t":%r,"a":%r,"b":0.5}' % (t, 1e-3 * t) for t in times])
     proc = start("export", str(log), "--csv", "out.csv", cwd=tmp_path)
     wait_for(lambda: any(".part" in p.name for p in tmp_path.iterdir()), 30, 0.0005)
