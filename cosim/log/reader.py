@@ -757,6 +757,7 @@ class LoggedTraffic:
         self.until = float(until)
         self._feed = _FrameFeed(self.path, length, step)
         self._messages = iter_messages(self.path, [TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
+        self._pending: dict | None = None  # the next logged frame, read but not yet needed
         self._exhausted = False
 
     def check(self) -> int:
@@ -781,24 +782,37 @@ class LoggedTraffic:
         """Logged (non-empty) frames read so far."""
         return self._feed.frames
 
-    def _more(self) -> None:
-        """Read up to and including the next frame; at the end of the log, pad to :attr:`until`."""
+    def _next_frame(self) -> dict | None:
+        """The next logged frame (vehicle types on the way are taken in), or None at the end of the log."""
         for topic, message in self._messages:
             if topic == TOPIC_VEHICLE_TYPES:
                 self._feed.vehicle_type(message)
             else:
-                self._feed.frame(message)
-                return
+                return message
         self._exhausted = True
-        self._feed.pad(self.until)
+        return None
 
     def block(self, times: np.ndarray) -> TrafficBlock:
-        """The vehicles at ``times`` (s), interpolated between the logged frames (the TrafficSource protocol)."""
+        """The vehicles at ``times`` (s), interpolated between the logged frames (the TrafficSource protocol).
+
+        Frames are read, and the empty ones between them made, only as far as ``times`` need: a long
+        stretch without vehicles costs no memory either.
+        """
         traffic = self._feed.traffic
-        while traffic.last_time < times[-1] - 1e-9 and not self._exhausted:
-            self._more()
+        step = self._feed.step
+        need = float(times[-1])
+        while traffic.last_time < need - 1e-9:
+            if self._pending is None and not self._exhausted:
+                self._pending = self._next_frame()
+            if self._pending is not None and float(self._pending["t"]) < need + 0.5 * step:
+                self._feed.frame(self._pending)  # the empty frames before it, then it
+                self._pending = None
+            else:  # the next logged frame lies beyond: empty frames up to ``need``
+                self._feed.pad(min(need, self.until) + 0.5 * step - 1e-9)
+                if self._pending is None and self._exhausted and traffic.last_time < need - 1e-9:
+                    break  # past the replay's end: FrameTraffic says so
         out = traffic.block(times)
-        traffic.forget_before(float(times[-1]))
+        traffic.forget_before(need)
         return out
 
     def close(self) -> None:
