@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import signal
 import sys
+import threading
 from typing import Any
 
 from cosim.errors import interruption
@@ -39,9 +40,10 @@ def main(argv: list[str] | None = None) -> int:
             pass
         return 128 + signum
     finally:
-        for signum, handler in previous.items():
-            if handler is not None:
-                signal.signal(signum, handler)
+        if threading.current_thread() is threading.main_thread():  # handlers can only be set there
+            for signum, handler in previous.items():
+                if handler is not None:
+                    signal.signal(signum, handler)
 
 
 def __getattr__(name: str) -> Any:
