@@ -19,9 +19,9 @@ the only package that prints.
 
 Every :class:`cosim.errors.CosimError` becomes ``cosim: error: <message>`` on
 stderr and exit status 2 (as for usage errors); a :class:`cosim.errors.ModelError`
-during the time integration (the solution diverged) exits with 1 (the log then
-ends with status "error"); Ctrl-C exits with 130 (the log ends with status
-"interrupted").
+after the time stepping started (the solution diverged) exits with 1 (the log then
+ends with status "error"); SIGINT (Ctrl-C), SIGTERM and SIGHUP exit with 128 +
+the signal's number, 130, 143 and 129 (a started log ends with status "interrupted").
 """
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ import sys
 import textwrap
 
 from cosim import __version__
-from cosim.errors import CosimError
+from cosim.errors import CosimError, interruption
 from cosim.log.schemas import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
 from cosim.plots import MAX_MODE_SHAPES
 from cosim.run.export import EXPORT_TOPICS
@@ -44,7 +44,7 @@ from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
 from .static import cmd_static
 from .study import cmd_study
-from .text import EXIT_INTERRUPTED, EXIT_USAGE, report_error
+from .text import EXIT_USAGE, report_error
 from .validate import cmd_validate
 
 
@@ -108,7 +108,8 @@ def build_parser() -> argparse.ArgumentParser:
         )
         + "\n"
         + bundled_text()
-        + "\nErrors print 'cosim: error: ...' on stderr and exit with status 2.",
+        + "\nErrors print 'cosim: error: ...' on stderr and exit with status 2; SIGINT, SIGTERM and SIGHUP\n"
+        "exit with 128 + the signal's number. Limits on input sizes: docs/limits.md.",
         formatter_class=formatter,
     )
     parser.add_argument("--version", action="version", version=f"cosim {__version__}")
@@ -148,6 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
     modes.add_argument("--plot", metavar="FILE.png",
                        help=f"draw the first N (at most {MAX_MODE_SHAPES}) mode shapes: v, w and twist theta_x "
                             "along x, each normalised")
+    modes.add_argument("--force", "-f", action="store_true", help="overwrite the --plot figure if it exists")
     modes.set_defaults(func=cmd_modes)
 
     static = commands.add_parser(
@@ -198,17 +200,20 @@ def build_parser() -> argparse.ArgumentParser:
             constants and frequencies embedded (a log alone is enough to run it again:
             cosim replay). Then print a summary: sensor peaks, each vehicle's contact force
             and whether it lifted off, steps, wall time, real-time factor. A progress
-            display goes to stderr. The log is finished whatever ends the run: Ctrl-C
-            leaves status "interrupted", a diverging solution status "error".
+            display goes to stderr. The log is finished whatever ends the run: Ctrl-C,
+            SIGTERM or SIGHUP leave status "interrupted", a diverging solution status
+            "error" with its likely cause. An existing file is replaced only with --force,
+            and never the scenario or its input files.
 
             Without [[vehicles]]: the modal analysis (first 10 modes) and a static load
             case, a {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once
             on the bridge axis (y = 0) and once at the left deck edge (largest y),
             with each sensor's deck displacement for both (no log).
 
-            Exit status: 0 done, 1 the solution diverged (the log ends with status
-            "error"), 2 bad input (before any file is written), 130 interrupted (Ctrl-C;
-            the log ends with status "interrupted")."""
+            Exit status: 0 done, 1 the run failed after it started (the log ends with
+            status "error"), 2 bad input, SUMO's included (nothing is written), 128 + N
+            stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (the log ends with
+            status "interrupted"; nothing is written if the run had not started)."""
         ),
         epilog=textwrap.dedent(
             f"""\
@@ -233,7 +238,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="also write the sensor channels as CSV, columns t,<sensor names> (default: [output].csv "
                           "if given); the same as 'cosim export LOG --csv OUT.csv' after the run")
     run.add_argument("--force", "-f", action="store_true",
-                     help="overwrite the log and the CSV if they exist (default: refuse)")
+                     help="overwrite the log, the CSV or the summary if they exist (default: refuse; never "
+                          "the scenario or its input files)")
     run.add_argument("--quiet", "-q", action="store_true",
                      help="no progress display on stderr")
     run.set_defaults(func=cmd_run)
@@ -252,8 +258,9 @@ def build_parser() -> argparse.ArgumentParser:
             like a run; [output].log and [output].csv of the scenarios are not used.
 
             Exit status: 0 done, 1 the solution diverged or (own scenario) the channels
-            differ, 2 bad input (unreadable log, a vehicle off OTHER's deck, ...),
-            130 interrupted."""
+            differ, 2 bad input (unreadable or damaged log, an input file the log does not
+            hold, a vehicle off OTHER's deck, ...), 128 + N stopped by signal N (130
+            Ctrl-C, 143 SIGTERM, 129 SIGHUP)."""
         ),
         epilog=textwrap.dedent(
             """\
@@ -358,6 +365,8 @@ def build_parser() -> argparse.ArgumentParser:
     validate.add_argument("--out", default="validation", metavar="DIR",
                           help="folder for report.md and the plots (default: validation)")
     validate.add_argument("--quick", action="store_true", help="coarser settings (seconds instead of a minute)")
+    validate.add_argument("--force", "-f", action="store_true",
+                          help="replace the report (and plots) in DIR if it has one (default: refuse)")
     validate.set_defaults(func=cmd_validate)
 
     study = commands.add_parser(
@@ -373,8 +382,10 @@ def build_parser() -> argparse.ArgumentParser:
             failing run is recorded in the table; the others go on. docs/studies.md
             documents the study file and the output folder.
 
-            Exit status: 0 every run ok, 1 some run failed (see the table), 2 bad input,
-            130 interrupted (the same command resumes)."""
+            Exit status: 0 every run ok, 1 some run failed (see the table), 2 bad input
+            (also: --out is another study's folder), 128 + N stopped by signal N (130
+            Ctrl-C, 143 SIGTERM, 129 SIGHUP): the runs in progress stop with finished logs,
+            the table of the completed runs is written, the same command resumes."""
         ),
         epilog=textwrap.dedent(
             """\
@@ -418,9 +429,13 @@ def main(argv: list[str] | None = None) -> int:
     except CosimError as exc:
         report_error(str(exc))
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("cosim: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as exc:  # SIGINT, SIGTERM or SIGHUP where the command did not report it itself
+        signum, name = interruption(exc)
+        try:
+            print(f"cosim: interrupted ({name})", file=sys.stderr)
+        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
+            pass
+        return 128 + signum
     except BrokenPipeError:  # e.g. `cosim modes ... | head`
         try:
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - silence the flush at exit

@@ -7,7 +7,8 @@ import json
 from cosim import plots
 from cosim.core.bridge import BridgeModel
 from cosim.run.figures import plot_modes
-from cosim.run.outputs import check_writable
+from cosim.run.inputs import scenario_files
+from cosim.run.outputs import check_not_input, check_writable
 from cosim.run.payloads import SHAPE_NOTE, damping_payload, jsonable, modes_payload, section_payload
 from cosim.run.scenario import load_scenario
 
@@ -30,9 +31,10 @@ def theory_lines(bridge: BridgeModel) -> list[str]:
 
 def cmd_modes(args: argparse.Namespace) -> int:
     """Print the modes of a scenario's bridge (``--json``: only JSON); ``--plot`` draws the first shapes."""
-    if args.plot:
-        check_writable(args.plot, "plot", plots.figure_formats())
     scenario = load_scenario(args.scenario)
+    if args.plot:
+        check_not_input(args.plot, "plot", scenario_files(scenario))
+        check_writable(args.plot, "plot", plots.figure_formats(), force=args.force)
     bridge = scenario.build_bridge()
     modal = bridge.modes(count=args.count)
     if args.json:

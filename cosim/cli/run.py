@@ -17,8 +17,9 @@ from cosim.core.bridge import BridgeModel
 from cosim.core.traffic import vehicle_of
 from cosim.errors import CosimError
 from cosim.run.export import export_csv
-from cosim.run.logged import RunFailed, RunOutcome, run_logged
-from cosim.run.outputs import atomic_write, check_new_file, check_writable, unique_path
+from cosim.run.inputs import scenario_files
+from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome, run_logged
+from cosim.run.outputs import atomic_write, check_new_file, check_not_input, check_writable, unique_path
 from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
 from cosim.run.replay import Comparison, compare_sensors, replay_scenario
 from cosim.run.scenario import Scenario, load_scenario
@@ -26,7 +27,6 @@ from cosim.run.static import STATIC_LOAD_N, static_cases
 from cosim.run.units import display_unit
 
 from .text import (
-    EXIT_INTERRUPTED,
     EXIT_RUN_FAILED,
     damping_lines,
     fmt_g,
@@ -67,7 +67,8 @@ def _run_static(scenario: Scenario, args: argparse.Namespace) -> int:
     if args.csv is not None:
         raise CosimError(f"{args.csv}: the scenario has no [[vehicles]]: no sensor time histories for --csv")
     if args.out is not None:
-        check_writable(args.out, "summary")
+        check_not_input(args.out, "summary", scenario_files(scenario))
+        check_writable(args.out, "summary", force=args.force)
     print(scenario_line(scenario))
     print(f"note: {NO_VEHICLES}")
     bridge = scenario.build_bridge()
@@ -115,7 +116,11 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
 
 
 class Progress:
-    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise."""
+    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise.
+
+    It appears with the first block of time steps: a run refused while it is
+    being set up (bad input, a limit, SUMO) prints its one error line alone.
+    """
 
     def __init__(self, duration: float, show: bool) -> None:
         self.duration = duration
@@ -123,21 +128,25 @@ class Progress:
         self._stream = sys.stderr
         self._bar: Any = None
         self._tenths: int | None = None  # the light form: tenths printed so far
-        if not show:
-            return
+        self._show = show
+
+    def _start(self) -> None:
+        self._show = False
         if self._stream.isatty():
             from tqdm import tqdm
 
             self._bar = tqdm(
-                total=duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
+                total=self.duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
                 bar_format="{desc} {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]",
             )
         else:
             self._tenths = 0
-            print(f"Simulating {duration:g} s:", end="", file=self._stream, flush=True)
+            print(f"Simulating {self.duration:g} s:", end="", file=self._stream, flush=True)
 
     def __call__(self, fraction: float) -> None:
         self.fraction = fraction
+        if self._show:
+            self._start()
         if self._bar is not None:
             self._bar.update(min(fraction * self.duration, self.duration) - self._bar.n)
         elif self._tenths is not None:
@@ -348,16 +357,20 @@ def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, ar
         outcome = run_logged(scenario, log_path, force=args.force, bridge=bridge, progress=progress, **extra)
     except RunFailed as exc:
         progress.close()
-        report_error(f"{exc}\nthe run failed; the log {exc.log_path} is finished and ends with status \"error\"")
+        report_error(f"{exc} (the run failed; its log {exc.log_path} is finished, status \"error\")")
         return EXIT_RUN_FAILED, None
-    except KeyboardInterrupt:
+    except RunInterrupted as exc:
         progress.close()
-        where = (f"the log up to there is in {log_path} (finished, status \"interrupted\")" if log_path.exists()
-                 else "no log was written")
-        print(f"cosim: interrupted at about t = {progress.fraction * duration:.4g} s of {duration:g} s; {where}",
-              file=sys.stderr)
-        return EXIT_INTERRUPTED, None
-    progress.close()
+        where = (f"the log up to there is in {exc.log_path} (finished, status \"interrupted\")"
+                 if exc.log_path is not None else "the run had not started: no log was written")
+        try:
+            print(f"cosim: interrupted by {exc.name} at about t = {progress.fraction * duration:.4g} s of "
+                  f"{duration:g} s; {where}", file=sys.stderr)
+        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
+            pass
+        return 128 + exc.signum, None
+    finally:
+        progress.close()
     return 0, outcome
 
 
@@ -375,7 +388,10 @@ def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
     default = scenario.log_path or unique_path(scenario.default_log_path())
     log_path = _log_target(args.out, default, args.force)
     csv_path = Path(args.csv) if args.csv is not None else scenario.csv_path
+    inputs = scenario_files(scenario)
+    check_not_input(log_path, "log", inputs)
     if csv_path is not None:
+        check_not_input(csv_path, "sensor CSV", [*inputs, ("the run's log (--out)", log_path)])
         check_new_file(csv_path, "sensor CSV", args.force)
     print(scenario_line(scenario))
     bridge = scenario.build_bridge()
@@ -399,8 +415,8 @@ def cmd_replay(args: argparse.Namespace) -> int:
         scenario = plan.scenario
         default = unique_path(scenario.default_log_path(suffix="-replay"))
         log_path = _log_target(args.out, default, args.force)
-        if log_path.resolve() == log.resolve():
-            raise CosimError(f"{log_path}: the replay cannot overwrite the log it replays")
+        check_not_input(log_path, "replay's log", [("the log it replays", log),
+                                                   *(scenario_files(other) if other is not None else [])])
         status_word = plan.overview.status_word
         if plan.traffic is not None:
             what = f"its SUMO traffic ({plan.record.get('traffic', 'logged frames')}; SUMO is not run again)"
@@ -414,9 +430,13 @@ def cmd_replay(args: argparse.Namespace) -> int:
             print(f"Bridge, sensors, road and solver: {other.source if other else ''} ({scenario.title})")
         bridge = scenario.build_bridge()
         print_lines(_header_lines(scenario, bridge, log_path, plan.duration))
-        status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
-                                           attachments=plan.attachments, traffic=plan.traffic,
-                                           duration=plan.duration)
+        try:
+            status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
+                                               attachments=plan.attachments, traffic=plan.traffic,
+                                               duration=plan.duration)
+        finally:
+            if plan.traffic is not None:
+                plan.traffic.close()
     if outcome is None:
         return status
     _print_outcome(scenario, outcome)

@@ -5,6 +5,8 @@ import argparse
 import sys
 from typing import Any
 
+from cosim.errors import interruption
+
 
 def cmd_study(args: argparse.Namespace) -> int:
     from cosim.study import load_study, run_study, summary_text
@@ -39,12 +41,16 @@ def cmd_study(args: argparse.Namespace) -> int:
     try:
         outcome = run_study(study, workers=args.workers, scheduler=args.scheduler, progress=progress,
                             redo=args.redo, plots=False if args.no_plots else None)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         if bar is not None:
             bar.close()
-        print(f"cosim: interrupted; the runs finished so far are in {study.output / 'results.csv'}; "
-              "run the same command again to resume", file=sys.stderr)
-        return 130
+        signum, name = interruption(exc)
+        try:
+            print(f"cosim: interrupted by {name}; the runs completed so far are in {study.output / 'results.csv'}; "
+                  "run the same command again to resume", file=sys.stderr)
+        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
+            pass
+        return 128 + signum
     if bar is not None:
         bar.close()
     print(summary_text(outcome))

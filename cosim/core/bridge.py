@@ -40,6 +40,7 @@ from .element import (
     shear_parameters,
     torsion_parameter,
 )
+from .limits import MAX_DOFS
 from .section import Material, SectionProperties
 
 __all__ = [
@@ -436,6 +437,13 @@ class BridgeModel:
             w2, phi = spla.eigsh(self.K_ff, k=count, M=self.M_ff, sigma=0.0, which="LM")
             order = np.argsort(w2)
             w2, phi = w2[order], phi[:, order]
+        if len(w2) < count or not np.all(np.isfinite(w2)) or not np.all(np.isfinite(phi)):
+            # The mass (or stiffness) is out of the range double precision can resolve, e.g. rho = 1e-300.
+            raise ModelError(
+                f"the modal analysis found {len(w2)} of {count} modes: the mass and stiffness matrices are "
+                f"out of the range it can resolve (rho = {self.material.rho:g} kg/m^3, E = {self.material.E:g} Pa); "
+                "check the material and section constants"
+            )
         omega = np.sqrt(np.maximum(w2, 0.0))
         # Normalise each mode so its largest deflection is positive (repeatable signs).
         for j in range(phi.shape[1]):
@@ -573,6 +581,9 @@ def build_bridge(
         raise ConfigError("`elements_per_span` must be >= 1, one number or one per span")
     if len(supports) != len(spans) + 1:
         raise ConfigError(f"`supports` needs {len(spans) + 1} entries, one per support line (got {len(supports)})")
+    n_elements = sum(n_per)
+    MAX_DOFS.check(NODE_DOFS * (n_elements + 1), "`elements_per_span`",
+                   f"{n_elements:,} elements in {len(spans)} span(s), {NODE_DOFS} per node")
     support_sets = tuple(support_dofs(s) for s in supports)
     theory = DEFAULT_THEORY if theory is None else theory
     if not isinstance(theory, BeamTheory):

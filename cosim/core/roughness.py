@@ -11,6 +11,7 @@ generated profile equals the target PSD at every generated wavenumber.
 from __future__ import annotations
 
 import csv
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,8 @@ import numpy as np
 import numpy.typing as npt
 
 from cosim.errors import ConfigError
+
+from .limits import MAX_ROAD_FILE_BYTES, MAX_ROAD_POINTS
 
 ISO_CLASSES = "ABCDEFGH"
 N0 = 0.1  # reference spatial frequency, cycle/m
@@ -126,6 +129,10 @@ def iso8608_profile(
     n_paths = len(path_y)
     # A periodic grid at least 1/N_MIN long, so the lowest wavenumber in the band is represented.
     length = max(x_end - x_start, 1.0 / N_MIN)
+    # Bounded before allocating: a bridge km long, or many wheel paths, would make this grid huge.
+    MAX_ROAD_POINTS.check((length / dx + 2) * n_paths, "`class`",
+                          f"{length:g} m of road every {dx:g} m on {n_paths} wheel path(s); the bridge's length "
+                          "sets the road's")
     nx = int(np.ceil(length / dx))
     nx += nx % 2
     length = nx * dx
@@ -151,34 +158,62 @@ def iso8608_profile(
 def profile_from_csv(path: str | Path) -> RoadProfile:
     """A user profile from a CSV file with columns ``x, r`` (m, m), used for every wheel path.
 
-    The file is parsed as numbers only. x must increase; it is resampled on a
-    uniform grid at the smallest spacing in the file, and the slope is the
+    The file is parsed as numbers only: UTF-8 text, one ``x, r`` pair per line
+    (a header line and ``#`` comment lines are skipped), at most
+    :data:`~cosim.core.limits.MAX_ROAD_FILE_BYTES` bytes. x must increase; it is
+    resampled on a uniform grid at the smallest spacing in the file (at most
+    :data:`~cosim.core.limits.MAX_ROAD_POINTS` points), and the slope is the
     derivative of the piecewise-linear profile.
+
+    Raises:
+        ConfigError: one line naming the file (and the line) and what is wrong.
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        size = path.stat().st_size
+        MAX_ROAD_FILE_BYTES.check(size, f"{path}", "the size of the road profile file")
+        data = path.read_bytes()
     except OSError as exc:
         raise ConfigError(f"{path}: cannot read road profile ({exc.strerror})") from None
-    xs, rs = [], []
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        text = "\0"
+    if "\0" in text:
+        raise ConfigError(f"{path}: not a text file; a road profile is a CSV of 'x, r' lines (m, m)")
+    xs: list[float] = []
+    rs: list[float] = []
+    header_seen = False
     for lineno, row in enumerate(csv.reader(text.splitlines()), start=1):
-        if not row or row[0].strip().startswith("#"):
+        if not row or not "".join(row).strip() or row[0].strip().startswith("#"):
             continue
+        shown = _snippet(",".join(row))
         try:
-            x, r = float(row[0]), float(row[1])
-        except (ValueError, IndexError):
-            if lineno == 1:
-                continue  # header
-            raise ConfigError(f"{path}: line {lineno}: expected two numbers 'x, r' (got {','.join(row)!r})") from None
-        xs.append(x)
-        rs.append(r)
+            values = [float(cell) for cell in row]
+        except ValueError:
+            if not header_seen and not xs:
+                header_seen = True
+                continue  # the header
+            raise ConfigError(f"{path}: line {lineno}: expected two numbers 'x, r' (got {shown})") from None
+        if len(values) != 2:
+            raise ConfigError(f"{path}: line {lineno}: expected two columns 'x, r', got {len(values)} ({shown})")
+        for name, value in zip(("x", "r"), values):
+            if not math.isfinite(value):
+                raise ConfigError(f"{path}: line {lineno}: {name} must be a finite number (got {shown})")
+        if xs and not values[0] > xs[-1]:
+            raise ConfigError(f"{path}: line {lineno}: x must increase strictly (got x = {values[0]:g} after "
+                              f"{xs[-1]:g})")
+        xs.append(values[0])
+        rs.append(values[1])
     if len(xs) < 2:
         raise ConfigError(f"{path}: a road profile needs at least two rows of 'x, r'")
     x_arr, r_arr = np.array(xs), np.array(rs)
-    if np.any(np.diff(x_arr) <= 0) or not np.all(np.isfinite(x_arr)) or not np.all(np.isfinite(r_arr)):
-        raise ConfigError(f"{path}: x must be finite and strictly increasing")
     # Uniform grid from the first to the last x at (at most) the file's smallest spacing.
-    n = int(np.ceil((x_arr[-1] - x_arr[0]) / float(np.min(np.diff(x_arr))) - 1e-9)) + 1
+    spacing = float(np.min(np.diff(x_arr)))
+    points = (x_arr[-1] - x_arr[0]) / spacing + 1
+    MAX_ROAD_POINTS.check(points, f"{path}", f"{x_arr[-1] - x_arr[0]:g} m resampled at the file's smallest x "
+                                             f"spacing, {spacing:g} m")
+    n = int(np.ceil(points - 1 - 1e-9)) + 1
     grid = np.linspace(x_arr[0], x_arr[-1], n)
     dx = float(grid[1] - grid[0])
     r_grid = np.interp(grid, x_arr, r_arr)
@@ -187,6 +222,11 @@ def profile_from_csv(path: str | Path) -> RoadProfile:
         path_y=(0.0,), x0=float(grid[0]), dx=dx, r=r_grid[None, :], r_x=r_x[None, :],
         description=f"user profile {path.name}",
     )
+
+
+def _snippet(text: str, limit: int = 40) -> str:
+    """A line of the file for a message, quoted and cut short (the file may hold anything)."""
+    return repr(text if len(text) <= limit else text[:limit] + "...")
 
 
 def averaged_psd(r: npt.NDArray[np.float64], dx: float, edges: Sequence[float]) -> tuple[np.ndarray, np.ndarray]:

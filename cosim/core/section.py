@@ -17,6 +17,8 @@ import numpy as np
 
 from cosim.errors import ConfigError, ModelError
 
+from .limits import MAX_SECTION_TRIANGLES
+
 
 @dataclass(frozen=True)
 class Material:
@@ -264,12 +266,18 @@ def section_from_plates(
     """
     rows = _validated_plates(plates)
     nu = _check_nu(nu)
+    given = mesh_size is not None
     if mesh_size is None:
         mesh_size = default_mesh_size(plates)
     else:
         mesh_size = _finite(mesh_size, "mesh_size")
         if not mesh_size > 0:
             raise ConfigError(f"`mesh_size` must be > 0 m^2 (got {mesh_size!r})")
+    # Bounded before meshing: the mesher and solver allocate per triangle (1e-5 m^2 on a deck: MemoryError).
+    area = sum(math.hypot(r[2] - r[0], r[3] - r[1]) * r[4] for r in rows)
+    MAX_SECTION_TRIANGLES.check(
+        area / mesh_size, "`mesh_size`" if given else "`mesh_size` (the default, t_min^2 / 8)",
+        f"about {area:.4g} m^2 of plates / {mesh_size:.3g} m^2 per triangle; a larger mesh_size makes fewer")
     _check_connected(rows)
     return _solve_fe(_cache_key(rows), nu, mesh_size)
 

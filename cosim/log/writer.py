@@ -33,7 +33,7 @@ from mcap.writer import CompressionType, Writer
 from cosim import __version__
 from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
 from cosim.core.vehicles import model_to_dict
-from cosim.errors import LogError
+from cosim.errors import LogError, interruption_message
 
 from .schemas import (
     PROFILE,
@@ -164,7 +164,9 @@ class LogRecorder:
             self._stream: IO[bytes] = open(self.path, "wb")
         except OSError as exc:
             raise LogError(f"{self.path}: cannot create the log ({exc.strerror})") from None
-        self._writer = _BulkWriter(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        # Data-section CRC on: a reader can then tell a file changed after it was written (cosim.log.reader).
+        self._writer = _BulkWriter(self._stream, chunk_size=chunk_size, compression=CompressionType.ZSTD,
+                                   enable_data_crcs=True)
         self._writer.start(profile=PROFILE, library=f"cosim {__version__}")
         self.sensor_names = list(sensor_names)
         self._channels: dict[str, int] = {}
@@ -248,7 +250,7 @@ class LogRecorder:
         if exc_type is None:
             self.close("finished")
         elif issubclass(exc_type, KeyboardInterrupt):
-            self.close("interrupted", "interrupted by the user (SIGINT)")
+            self.close("interrupted", interruption_message(exc))
         else:
             self.close("error", f"{exc_type.__name__}: {exc}")
 

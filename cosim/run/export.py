@@ -18,7 +18,7 @@ from cosim.log.schemas import (
     TOPIC_VEHICLES,
 )
 
-from .outputs import atomic_write, check_new_file
+from .outputs import atomic_write, check_new_file, check_not_input
 
 #: The topics a log can be exported from.
 EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS)
@@ -61,6 +61,7 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
         columns = list(EVENT_COLUMNS)
     else:
         columns = list(STATUS_COLUMNS)
+    check_not_input(out, "CSV", [("the log", log)])
     check_new_file(out, "CSV", force)
     rows = 0
     with atomic_write(out, "CSV") as partial, open(partial, "w", newline="", encoding="utf-8") as fh:

@@ -46,3 +46,17 @@ def input_files(scenario: Scenario) -> list[InputFile]:
             key = "traffic.sumo_config" if path == sumo_cfg else ""
             found.append(InputFile(key, str(path), path, f"sumo/{rel.as_posix()}"))
     return found
+
+
+def scenario_files(scenario: Scenario) -> list[tuple[str, Path]]:
+    """Every file a run of ``scenario`` reads, as (what it is, path): the scenario file and its input files.
+
+    For :func:`cosim.run.outputs.check_not_input`: no output of a command may be one of these.
+    """
+    found: list[tuple[str, Path]] = []
+    source = Path(scenario.source)
+    if source.is_file():
+        found.append(("the scenario", source))
+    for item in input_files(scenario):
+        found.append((f"an input file of the scenario ({item.key or 'SUMO'})", item.path))
+    return found

@@ -12,20 +12,23 @@ from __future__ import annotations
 import contextlib
 import datetime
 import json
+import os
 import platform
-import signal
-import threading
+import secrets
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from cosim import __version__
+from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
+from cosim.core.limits import MAX_STEPS
 from cosim.core.simulation import SimulationResult, simulate
-from cosim.errors import ConfigError, CosimError, LogError, ModelError, SumoError
+from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.schemas import (
     METADATA_NAME,
     REPLAY_METADATA_NAME,
@@ -37,8 +40,9 @@ from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 from .inputs import input_files
 from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
-from .scenario import Scenario
-from .simulate import build_traffic
+from .scenario import RING_DOWN, Scenario
+from .signals import StopGuard, stop_signals
+from .simulate import SOLVER_FAILURES, build_traffic, likely_cause
 
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
@@ -112,32 +116,61 @@ class _Samples:
         self.count += int(np.count_nonzero(keep))
 
 
-class _InterruptOnce:
-    """Ctrl-C stops the run once; while the log is being finished, further Ctrl-C are held back.
+class RunInterrupted(Interrupted):
+    """A logged run stopped by a signal (SIGINT, SIGTERM or SIGHUP).
 
-    Installed only over Python's default SIGINT handler, in the main thread.
+    Attributes:
+        log_path: the finished log (last status "interrupted"), or None when the run had not
+            started and no log was written.
     """
 
-    def __init__(self) -> None:
-        self.closing = False
-        self._old: Any = None
+    def __init__(self, signum: int, name: str, log_path: Path | None) -> None:
+        super().__init__(signum, name)
+        self.log_path = log_path
 
-    def __enter__(self) -> "_InterruptOnce":
-        if threading.current_thread() is threading.main_thread() and \
-                signal.getsignal(signal.SIGINT) is signal.default_int_handler:
-            self._old = signal.signal(signal.SIGINT, self._handle)
-        return self
 
-    def _handle(self, signum, frame) -> None:  # noqa: ANN001
-        if self.closing:
-            return
-        self.closing = True
-        raise KeyboardInterrupt
+class _StartsOnFirstBlock:
+    """A traffic source that calls ``on_start`` when the time stepping asks for its first block.
 
-    def __exit__(self, *exc: object) -> None:
-        if self._old is not None:
-            signal.signal(signal.SIGINT, self._old)
-            self._old = None
+    Everything before that (the basis, the coupled system, SUMO) can still fail
+    on bad input; from then on the run has started and its log is kept.
+    """
+
+    def __init__(self, traffic: Any, on_start: Callable[[], None]) -> None:
+        self.traffic = traffic
+        self._on_start: Callable[[], None] | None = on_start
+
+    def block(self, times):  # noqa: ANN001, ANN201 - the TrafficSource protocol
+        if self._on_start is not None:
+            on_start, self._on_start = self._on_start, None
+            on_start()
+        return self.traffic.block(times)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.traffic, name)
+
+
+def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: float, given: bool,
+                modal: Any) -> None:
+    """Bounds that the run itself would only hit after its log exists: time steps, the basis."""
+    if given:
+        key = "the replayed log's duration"
+    elif scenario.solver.duration is not None:
+        key = f"{scenario.source}: solver.duration"
+    elif scenario.traffic is not None:
+        key = f"{scenario.source}: traffic.end"
+    else:
+        key = f"{scenario.source}: solver.duration (default: the last vehicle leaves the deck + {RING_DOWN:g} s)"
+    MAX_STEPS.check(duration / solver.dt, key, f"{duration:g} s at solver.dt = {solver.dt:g} s")
+    if solver.basis == "direct" and len(bridge.free) > DirectBasis.MAX_DIRECT_DOFS:
+        raise ConfigError(
+            f"{scenario.source}: solver.basis: the direct basis keeps a dense {len(bridge.free)} x "
+            f"{len(bridge.free)} inverse; above {DirectBasis.MAX_DIRECT_DOFS} free DOFs use basis = \"modal\" "
+            "(or fewer bridge.elements_per_span)")
+    if solver.basis == "modal" and solver.cutoff_hz is not None and len(modal.f_hz) and \
+            solver.cutoff_hz < modal.f_hz[0]:
+        raise ConfigError(f"{scenario.source}: solver.cutoff_hz: no mode below {solver.cutoff_hz:g} Hz (the first "
+                          f"is at {modal.f_hz[0]:.4g} Hz); raise cutoff_hz or give modes")
 
 
 def run_logged(
@@ -155,16 +188,25 @@ def run_logged(
 ) -> RunOutcome:
     """Run ``scenario``'s vehicles over its bridge and stream everything into the MCAP log ``log_path``.
 
-    Everything that can fail on bad input (bridge, road, vehicles, modes) is
-    built before the log file is created. The log then holds the scenario
-    text and input files, ``resolved.json``, ``section.json``, ``modes.json``,
-    a "cosim" metadata record, the sensor samples (from t = 0, at rest), the
-    vehicles on the deck, traffic events and status messages.
+    Everything that can fail on bad input (bridge, road, vehicles, modes,
+    limits, SUMO: its network, edges and vehicle types) is checked before the
+    log file is created. The log is written under a temporary name in the same
+    folder and takes its name when the time stepping starts: a run that fails
+    or is stopped before that leaves nothing (and an existing ``log_path``
+    untouched, even with ``force``). From then on the log is kept, and finished
+    whatever ends the run: its last status says why. The log holds the
+    scenario text and input files, ``resolved.json``, ``section.json``,
+    ``modes.json``, a "cosim" metadata record, the sensor samples (from t = 0,
+    at rest), the vehicles on the deck, traffic events and status messages.
+
+    SIGINT, SIGTERM and SIGHUP stop the run (in the main thread, unless the
+    program installed its own handlers): the log ends with status
+    "interrupted" and the signal's name.
 
     Args:
-        scenario: a scenario with [[vehicles]].
+        scenario: a scenario with [[vehicles]] or [traffic].
         log_path: the log to write (its folder is created).
-        force: overwrite an existing log.
+        force: overwrite an existing log (once the run has started).
         bridge: the scenario's model, if already built.
         progress: called with the fraction done after every block of steps.
         replay: for a replay, what was replayed (stored as the "replay" metadata record).
@@ -174,9 +216,10 @@ def run_logged(
         duration: simulated time instead of the scenario's, s.
 
     Raises:
-        KeyboardInterrupt: Ctrl-C; the log is finished first, with status "interrupted".
-        RunFailed: the solution diverged; the log is finished first, with status "error".
-        ConfigError, ModelError, LogError: bad input, before the log is created.
+        RunInterrupted: a signal; ``log_path`` is the finished log (status "interrupted"), or None if
+            the run had not started (nothing written).
+        RunFailed: the run failed after it started (e.g. diverged); the log ends with status "error".
+        ConfigError, ModelError, LogError, SumoError: bad input, before any file is written.
     """
     if not scenario.vehicles and scenario.traffic is None and traffic is None:
         raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
@@ -190,18 +233,21 @@ def run_logged(
     road = scenario.build_road()
     solver = scenario.solver_settings()
     sensors = scenario.sensors_core()
+    given = duration is not None
     duration = duration if duration is not None else scenario.duration
     every = scenario.output_every
     rate_hz = scenario.output_rate_hz
     names = [s.name for s in sensors]
     modal = bridge.modes(count=LOGGED_MODES)
+    _check_size(scenario, bridge, solver, duration, given, modal)
     inputs = input_files(scenario)
     files = {}
     for item in inputs:
         try:
             files[item.attachment] = item.path.read_bytes()
         except OSError as exc:
-            raise ConfigError(f"{scenario.source}: {item.key}: cannot read {item.path} ({exc.strerror})") from None
+            raise ConfigError(f"{scenario.source}: {item.key or item.attachment}: cannot read {item.path} "
+                              f"({exc.strerror})") from None
     check_new_file(log_path, "log", force)
     meta = {
         "version": __version__,
@@ -228,51 +274,113 @@ def run_logged(
         "derived": {"duration": duration, "output_every": every, "rate_hz": rate_hz,
                     "leave_time": jsonable(scenario.leave_time)},
     }
+    documents = {
+        **files, **(attachments or {}),
+        "resolved.json": json.dumps(jsonable(resolved), indent=1).encode(),
+        "section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
+        "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
+                                 indent=1).encode(),
+    }
+    with stop_signals() as guard, contextlib.ExitStack() as sumo:
+        try:
+            if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
+                traffic = sumo.enter_context(build_traffic(scenario))
+        except KeyboardInterrupt as exc:
+            guard.closing = True
+            raise RunInterrupted(*interruption(exc), None) from None
+        return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
+                       duration, every, rate_hz, meta, replay, documents, progress)
+
+
+def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,
+            live_sumo: bool, road: Any, solver: Any, sensors: list, duration: float, every: int, rate_hz: float,
+            meta: dict[str, str], replay: dict[str, str] | None, documents: dict[str, bytes],
+            progress: Callable[[float], None] | None) -> RunOutcome:
+    """The log itself: written under a temporary name until the stepping starts, then as ``log_path``."""
+    names = [s.name for s in sensors]
+    partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
     extremes = _DeckTimes()
     samples = _Samples()
     wall_start = time.perf_counter()
-    with _InterruptOnce() as guard, LogRecorder(log_path, names, force=force) as rec:
+    state = {"started": False}
+
+    def on_start() -> None:
+        try:
+            if log_path.exists() and not force:
+                raise LogError(f"{log_path}: already exists; refusing to overwrite the log (use --force)")
+            os.replace(partial, log_path)
+        except OSError as exc:
+            raise LogError(f"{log_path}: cannot create the log ({exc.strerror or exc})") from None
+        state["started"] = True
+
+    rec: LogRecorder | None = None
+
+    def discard() -> None:
+        if rec is not None:
+            with contextlib.suppress(Exception):
+                rec.close("error", "the run did not start")
+        with contextlib.suppress(OSError):
+            partial.unlink()
+
+    try:
+        try:
+            rec = LogRecorder(partial, names, force=False)
+        except LogError as exc:  # name the log the user asked for, not its temporary name
+            raise LogError(str(exc).replace(str(partial), str(log_path))) from None
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
-        for name, data in {**files, **(attachments or {})}.items():
-            media = {".csv": "text/csv", ".toml": "application/toml"}.get(Path(name).suffix.lower(),
-                                                                          "application/octet-stream")
+        for name, data in documents.items():
+            media = {".csv": "text/csv", ".toml": "application/toml", ".json": "application/json"}.get(
+                Path(name).suffix.lower(), "application/octet-stream")
             rec.attach(name, data, media)
-        rec.attach("resolved.json", json.dumps(jsonable(resolved), indent=1), "application/json")
-        rec.attach("section.json", json.dumps(section_payload(bridge.section), indent=1), "application/json")
-        rec.attach("modes.json", json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
-                                            indent=1), "application/json")
         rec.metadata(METADATA_NAME, meta)
         if replay:
             rec.metadata(REPLAY_METADATA_NAME, replay)
         rec.status(0.0, "started", f"{scenario.title}: {duration:g} s simulated, dt = {solver.dt:g} s, "
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
+        with BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
+            if live_sumo:
+                traffic.frame_sink = TrafficLogger(rec)
+            result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
+                              sensors=sensors, road=road, output_every=every, progress=progress,
+                              observers=[extremes, samples, logger], collect=False)
+            guard.closing = True  # a signal from here on must not cut the log's ending short
+    except KeyboardInterrupt as exc:
+        guard.closing = True
+        signum, name = interruption(exc)
+        if not state["started"] or rec is None:
+            discard()
+            raise RunInterrupted(signum, name, None) from None
+        rec.close("interrupted", interruption_message(exc), wall_time=time.perf_counter() - wall_start)
+        raise RunInterrupted(signum, name, log_path) from None
+    except (CosimError, *SOLVER_FAILURES) as exc:
+        guard.closing = True
+        if not state["started"] or rec is None:
+            discard()
+            if isinstance(exc, CosimError):
+                raise
+            raise ModelError(f"{scenario.source}: {exc}") from None
+        if isinstance(exc, CosimError) and not isinstance(exc, ModelError):
+            message = str(exc)
+        else:
+            text = str(exc) if isinstance(exc, ModelError) else \
+                f"the solution diverged: the solver met non-finite values ({type(exc).__name__}: {exc})"
+            message = f"{text}; likely cause: {likely_cause(scenario, road, solver)}"
         try:
-            with contextlib.ExitStack() as stack, \
-                    BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
-                if live_sumo:  # SUMO starts inside the log: a SUMO failure is the log's final status
-                    traffic = stack.enter_context(build_traffic(scenario, frame_sink=TrafficLogger(rec)))
-                result = simulate(bridge, logger.paced(traffic), duration, solver=solver, sensors=sensors, road=road,
-                                  output_every=every, progress=progress, observers=[extremes, samples, logger],
-                                  collect=False)
-                guard.closing = True  # a Ctrl-C from here on must not cut the log's ending short
-        except KeyboardInterrupt:
-            guard.closing = True
-            rec.close("interrupted", "interrupted by the user (SIGINT)", wall_time=time.perf_counter() - wall_start)
-            raise
-        except CosimError as exc:
-            guard.closing = True
-            try:
+            rec.close("error", message, wall_time=time.perf_counter() - wall_start)
+        except (OSError, ValueError, LogError):
+            pass  # the log itself failed (e.g. disk full): report the first error
+        raise RunFailed(f"{scenario.source}: {message}", log_path) from None
+    except BaseException as exc:  # a defect: the log still says so, and the traceback is not hidden
+        guard.closing = True
+        if not state["started"] or rec is None:
+            discard()
+        else:
+            with contextlib.suppress(Exception):
                 rec.close("error", f"{type(exc).__name__}: {exc}", wall_time=time.perf_counter() - wall_start)
-            except (OSError, ValueError, LogError):
-                pass  # the log itself failed (e.g. disk full): report the first error
-            if isinstance(exc, ModelError):
-                raise RunFailed(f"{scenario.source}: {exc}", log_path) from exc
-            if isinstance(exc, SumoError) and getattr(traffic, "sumo_steps", 0) > 0:
-                raise RunFailed(f"{scenario.source}: {exc}", log_path) from exc  # SUMO failed mid-run
-            raise
-        wall = time.perf_counter() - wall_start
-        rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
+        raise
+    wall = time.perf_counter() - wall_start
+    rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
     return RunOutcome(
         scenario=scenario, log_path=log_path, result=result, duration=duration, every=every, rate_hz=rate_hz,
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,

@@ -9,16 +9,21 @@
   flushed to disk and renamed over the target at the end; on any failure or
   interruption the temporary file is removed and the target is untouched.
 
-MCAP logs are the exception: a run streams into its log in place, so that a
-killed process leaves the part written so far (see :mod:`cosim.log.writer`).
+- :func:`check_not_input`: an output is never one of the command's inputs
+  (the log it reads, the scenario, its input files), even with ``--force``.
+
+MCAP logs are the exception: a run streams into its log, so that a killed
+process leaves the part written so far (see :mod:`cosim.log.writer`); it is
+written under a temporary name until the time stepping starts, so a run that
+never starts leaves nothing (:func:`cosim.run.logged.run_logged`).
 """
 from __future__ import annotations
 
 import contextlib
 import os
 import secrets
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Iterator, Sequence
 
 from cosim.errors import CosimError
 
@@ -35,6 +40,30 @@ def check_new_file(path: Path, what: str, force: bool = False) -> None:
         raise CosimError(f"{path}: cannot create the folder for the {what}: {str(blocking)!r} is a file")
 
 
+def same_file(a: str | os.PathLike[str], b: str | os.PathLike[str]) -> bool:
+    """Whether two paths name the same file (through links too), existing or not."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet): compare where they would be
+        return Path(a).resolve() == Path(b).resolve()
+
+
+def check_not_input(output: str | os.PathLike[str], what: str, inputs: Sequence[tuple[str, Path]]) -> None:
+    """Fail when an output of a command is one of its inputs, which even ``--force`` must not replace.
+
+    Args:
+        output: the file the command would write; what: which output (for the message).
+        inputs: (what it is, path) of everything the command reads: the log, the scenario, its input files.
+
+    Raises:
+        CosimError: ``output`` is one of ``inputs``.
+    """
+    for role, path in inputs:
+        if same_file(output, path):
+            raise CosimError(f"{output}: is {role} of this command; refusing to write the {what} over it "
+                             "(even with --force): choose another file name")
+
+
 def unique_path(path: Path) -> Path:
     """``path``, or ``<stem>-2<suffix>``, ``-3``, ... if it exists (for default names)."""
     if not path.exists():
@@ -46,13 +75,17 @@ def unique_path(path: Path) -> Path:
     raise CosimError(f"{path}: too many runs with this name in the same second")
 
 
-def check_writable(path: str | os.PathLike[str], what: str, suffixes: Sequence[str] | None = None) -> None:
+def check_writable(path: str | os.PathLike[str], what: str, suffixes: Sequence[str] | None = None,
+                   force: bool = False) -> None:
     """Fail before the work when an output file in an existing folder cannot be written: ``path`` is a
-    directory, its folder does not exist, or its suffix is not one of ``suffixes`` (e.g. figure formats).
-    An existing file is overwritten (summaries and figures of ``cosim modes`` and a static ``cosim run``)."""
+    directory, exists (without ``force``), its folder does not exist, or its suffix is not one of
+    ``suffixes`` (e.g. figure formats). For the summaries and figures of ``cosim modes`` and a static
+    ``cosim run``, whose folder is not created."""
     target = Path(path)
     if target.is_dir():
         raise CosimError(f"{path}: is a directory, expected a file name for the {what}")
+    if target.exists() and not force:
+        raise CosimError(f"{path}: already exists; refusing to overwrite the {what} (use --force)")
     parent = target.parent
     if not parent.is_dir():
         raise CosimError(f"{path}: cannot write the {what}: directory {str(parent)!r} does not exist")
@@ -95,6 +128,8 @@ def atomic_write(path: str | os.PathLike[str], what: str) -> Iterator[Path]:
         os.replace(partial, path)
     except OSError as exc:
         raise CosimError(f"{path}: cannot write the {what} ({exc.strerror or exc})") from None
+    except CosimError as exc:  # a writer's own message: it names the temporary file, the user gave ``path``
+        raise CosimError(str(exc).replace(str(partial), str(path))) from None
     finally:
         with contextlib.suppress(OSError):
             partial.unlink(missing_ok=True)

@@ -12,14 +12,16 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from cosim.errors import LogError
-from cosim.log.reader import LogOverview, iter_messages, open_log, read_traffic
+from cosim.errors import ConfigError, LogError
+from cosim.log.reader import LoggedTraffic, LogOverview, check_messages, iter_messages, open_log
 from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC
+from cosim.sumo.files import FILE_OPTIONS, read_config
 
 from .inputs import input_files
 from .scenario import Scenario, parse_scenario
@@ -31,20 +33,109 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 
-def _extract(overview: LogOverview, folder: Path) -> dict[str, str]:
-    """Write the log's input files into ``folder``; returns dotted key -> attachment name."""
-    try:
-        inputs = json.loads(overview.info.get("inputs", "{}"))
-    except ValueError:
-        raise LogError(f"{overview.path}: malformed cosim metadata (inputs)") from None
-    for key, name in inputs.items():
-        pure = PurePosixPath(name)
-        if pure.is_absolute() or ".." in pure.parts or name not in overview.attachments:
-            raise LogError(f"{overview.path}: input file {name!r} ({key}) is missing or has an unsafe name")
+#: The scenario keys that name input files; a replay takes each from the log's attachments only.
+FILE_KEYS: tuple[str, ...] = ("road.profile", "traffic.sumo_config")
+#: Attachments that are documents about the run, not its input files.
+DERIVED_ATTACHMENTS = frozenset({SCENARIO_ATTACHMENT, "resolved.json", "section.json", "modes.json"})
+_DRIVE = re.compile(r"^[A-Za-z]:")
+
+
+def _safe_name(name: str) -> PurePosixPath | None:
+    """``name`` as a relative path inside a folder, or None if it could point anywhere else."""
+    if not name or "\\" in name or "\0" in name or _DRIVE.match(name) or len(name) > 1024:
+        return None
+    pure = PurePosixPath(name)
+    if pure.is_absolute() or any(part in ("..", ".", "") for part in name.split("/")):
+        return None
+    return pure
+
+
+def _extract(overview: LogOverview, folder: Path) -> tuple[dict[str, str], set[Path]]:
+    """Write the log's input files (every attachment but the documents about the run) into ``folder``.
+
+    Returns the "inputs" metadata (dotted key -> attachment name) and the files written.
+
+    Raises:
+        LogError: an attachment's name is absolute, has ``..`` or is not a plain relative path; an input
+            names a key that is not a file key or an attachment the log does not hold.
+    """
+    path = overview.path
+    written: set[Path] = set()
+    for name, data in overview.attachments.items():
+        if name in DERIVED_ATTACHMENTS or name.startswith("replay/"):
+            continue
+        pure = _safe_name(name)
+        if pure is None:
+            raise LogError(f"{path}: attachment {name[:80]!r} has an unsafe name (absolute, '..' or not a plain "
+                           "relative path); a log's input files have relative names")
         target = folder.joinpath(*pure.parts)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(overview.attachments[name])
-    return inputs
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+        except OSError as exc:
+            raise LogError(f"{path}: attachment {name!r} cannot be written to a scratch folder "
+                           f"({exc.strerror or exc})") from None
+        written.add(target)
+    inputs = json.loads(overview.info.get("inputs", "{}"))  # checked by open_log: names -> names
+    for key, name in inputs.items():
+        if key not in FILE_KEYS:
+            raise LogError(f"{path}: the log's inputs name an unknown key {key[:80]!r} (file keys: "
+                           f"{', '.join(FILE_KEYS)})")
+        if _safe_name(name) is None or folder.joinpath(*PurePosixPath(name).parts) not in written:
+            raise LogError(f"{path}: input file {name[:80]!r} ({key}) is missing or has an unsafe name")
+    return inputs, written
+
+
+def _confine(overview: LogOverview, data: dict[str, Any], inputs: dict[str, str], folder: Path,
+             written: set[Path]) -> bool:
+    """Point every file key of the log's scenario at the log's own attachments, or refuse.
+
+    A crafted log could name ``/home/user/.ssh/id_rsa`` as its network or
+    ``/etc/passwd`` as its road profile; a replay reads such keys, and the files
+    the embedded SUMO config names, only from the attachments extracted into ``folder``.
+
+    Returns:
+        Whether a key was changed (the scenario's text must then be written anew).
+
+    Raises:
+        LogError: a file key or a file the SUMO config names is not one of the log's attachments.
+    """
+    path = overview.path
+    changed = False
+    for key, name in inputs.items():
+        if get_key(data, key) is not None and get_key(data, key) != name:
+            set_key(data, key, name)
+            changed = True
+    for key in FILE_KEYS:
+        value = get_key(data, key)
+        if value is None:
+            continue
+        if not isinstance(value, str) or value not in inputs.values():
+            raise LogError(f"{path}: the log's scenario names {key} = {str(value)[:80]!r}, which is not one of "
+                           "the log's attachments; a replay reads its input files only from the log")
+    config_name = get_key(data, "traffic.sumo_config")
+    if not isinstance(config_name, str):
+        return changed
+    config = folder.joinpath(*PurePosixPath(config_name).parts)
+    try:
+        parsed = read_config(config)
+    except ConfigError as exc:
+        raise LogError(f"{path}: the log's SUMO config: {exc}") from None
+    base = config.parent
+    for option in FILE_OPTIONS:
+        for _, names in parsed.options(option):
+            for name in names:
+                _confined_name(path, option, name, base, written)
+    return changed
+
+
+def _confined_name(path: Path, option: str, name: str, base: Path, written: set[Path]) -> None:
+    """Refuse a file named by the log's SUMO config unless it is one of the attachments written."""
+    pure = _safe_name(name)
+    target = Path(os.path.normpath(base.joinpath(*pure.parts))) if pure is not None else None
+    if target is None or target not in written:
+        raise LogError(f"{path}: the log's SUMO config names {option} {name[:80]!r}, which is not one of the "
+                       "log's attachments; a replay reads its input files only from the log")
 
 
 def _scenario_text(overview: LogOverview) -> str:
@@ -70,17 +161,34 @@ class ReplayPlan:
     duration: float | None = None
 
 
+def covered_time(overview: LogOverview) -> float:
+    """The simulated time a log covers, s: its last message's time, but no more than its sensor samples span.
+
+    A genuine log has a sample every ``every * dt``; a crafted one cannot claim
+    days of simulated time with a handful of messages.
+    """
+    info = overview.info
+    try:
+        span = overview.counts.get(TOPIC_SENSORS, 0) * int(float(info["every"])) * float(info["dt"])
+    except KeyError:
+        span = overview.end_time
+    return min(overview.end_time, span)
+
+
 def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario | None = None) -> ReplayPlan:
     """The scenario of a replay, with its input files written into ``folder`` (a scratch folder).
 
     Without ``other``: the log's own scenario (parsed from its embedded text,
-    never executed). With ``other``: ``other``'s bridge, sensors, road, solver
-    and output with the log's traffic: its ``[[vehicles]]``, or, for SUMO
-    traffic, the logged SUMO frames (positions along the original bridge's
-    axis; SUMO itself is not run again).
+    never executed), every input file taken from the log's attachments. With
+    ``other``: ``other``'s bridge, sensors, road, solver and output with the
+    log's traffic: its ``[[vehicles]]``, or, for SUMO traffic, the logged SUMO
+    frames (positions along the original bridge's axis; SUMO itself is not run
+    again), read from the log as the replay goes. The log is checked whole
+    first (checksums, every message it will use against its schema), so a
+    damaged or crafted log is refused before anything is written.
 
     Raises:
-        LogError: the log is unreadable or has no scenario.
+        LogError: the log is unreadable, damaged, has no scenario, or names input files it does not hold.
         ConfigError: the log's traffic does not fit ``other``'s bridge (e.g. a wheel path off its deck).
     """
     overview = open_log(log)
@@ -93,17 +201,22 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     record = {"log": str(overview.path), "log_scenario": overview.info.get("scenario", ""),
               "log_started": overview.info.get("started", ""), "log_status": overview.status_word}
     sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "traffic" in logged
+    check_messages(overview.path, [TOPIC_SENSORS])  # the traffic frames: LoggedTraffic.check below
+    covered = covered_time(overview)
+    duration: float | None = None
     if other is None:
-        inputs = _extract(overview, folder)
+        inputs, written = _extract(overview, folder)
         data = tomllib.loads(text)
-        changed = False
-        for key, name in inputs.items():
-            if get_key(data, key) != name:
-                set_key(data, key, name)
-                changed = True
+        changed = _confine(overview, data, inputs, folder, written)
         scenario = parse_scenario(toml_dumps(data) if changed else text, source, base_dir=folder)
+        for item in input_files(scenario):  # every file the run will embed: one of the log's own
+            if Path(os.path.normpath(item.path)) not in written:
+                raise LogError(f"{overview.path}: the log's scenario needs {item.path.name!r} ({item.key or 'SUMO'}), "
+                               "which is not one of the log's attachments")
         record["scenario"] = "the log's own"
         plan = ReplayPlan(scenario, overview, True, record)
+        if not sumo and scenario.duration > covered > 0:
+            duration = covered  # a log cut short: its own traffic replays only as far as it reached
     else:
         if not sumo and not logged.get("vehicles"):
             raise LogError(f"{overview.path}: the log's scenario has no [[vehicles]] and no [traffic]: "
@@ -127,17 +240,20 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
                        "replay/traffic-scenario.toml": text.encode()}
         plan = ReplayPlan(scenario, overview, False, record, attachments)
     if not sumo:
-        return plan
+        return ReplayPlan(plan.scenario, overview, plan.own, record, plan.attachments, None, duration)
     try:
-        duration = float(overview.info["duration"])
         step = float(logged["traffic"].get("step", 0.05))
     except (KeyError, ValueError, TypeError, AttributeError):
-        raise LogError(f"{overview.path}: malformed cosim metadata (duration or traffic step)") from None
+        step = math.nan
+    if not (math.isfinite(step) and step > 0):
+        raise LogError(f"{overview.path}: the log's scenario has no valid traffic.step")
     # Frames are logged only while vehicles are near the deck: pad to the logged run's end, or,
     # for a cut-off log, to the last time the log reached.
-    duration = min(duration, overview.end_time) if overview.end_time > 0 else duration
-    traffic, frames = read_traffic(overview.path, plan.scenario.bridge.length, step, until=duration)
-    record["traffic"] = f"{frames} logged SUMO frames"
+    duration = min(float(overview.info.get("duration", covered)), covered)
+    if not duration > 0:
+        raise LogError(f"{overview.path}: the log covers no simulated time: nothing to replay")
+    traffic = LoggedTraffic(overview.path, plan.scenario.bridge.length, step, until=duration)
+    record["traffic"] = f"{traffic.check()} logged SUMO frames"
     return ReplayPlan(plan.scenario, overview, plan.own, record, plan.attachments, traffic, duration)
 
 

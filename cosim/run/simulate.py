@@ -14,13 +14,39 @@ Runs with a log: :func:`cosim.run.logged.run_logged`.
 from __future__ import annotations
 
 import contextlib
-from typing import Any, Callable
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
 
 from cosim.core.bridge import BridgeModel
 from cosim.core.simulation import SimulationResult, simulate
 from cosim.errors import ConfigError, ModelError
 
 from .scenario import Scenario
+
+#: Exceptions of the compiled solver (numba, numpy) when non-finite values reach it: a diverged solution.
+SOLVER_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
+
+#: Vehicle parameters beyond these (SI units) are out of any road vehicle's range.
+_PLAUSIBLE = {"mass": (1.0, 1e6), "m_v": (1.0, 1e6), "m_w": (0.1, 1e5), "k_v": (1.0, 1e9), "c_v": (0.0, 1e8),
+              "k_t": (1.0, 1e10), "c_t": (0.0, 1e8)}
+
+
+def likely_cause(scenario: Scenario, road: Any, solver: Any) -> str:
+    """The likeliest reason a run diverged, from its inputs: a parameter out of range, else the step."""
+    for i, vehicle in enumerate(scenario.vehicles):
+        for key, value in vehicle.parameters.items():
+            low, high = _PLAUSIBLE.get(key, (-math.inf, math.inf))
+            if not low <= value <= high:
+                return (f"vehicles[{i}] ({vehicle.id}): {key} = {value:g} is outside any road vehicle's range "
+                        f"({low:g} to {high:g})")
+    peak = float(np.max(np.abs(road.r))) if road.r.size else 0.0
+    if not peak <= 1.0:
+        return f"road: the profile's elevations reach {peak:g} m (a road profile is a few cm at most)"
+    return (f"a parameter out of range, or a time step too large for the vehicles' and the bridge's dynamics "
+            f"(solver.dt = {solver.dt:g} s; try a smaller dt, or the modal basis with fewer modes)")
 
 
 def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = None) -> Any:
@@ -85,3 +111,7 @@ def simulate_scenario(
             )
     except (ConfigError, ModelError) as exc:
         raise type(exc)(f"{scenario.source}: {exc}") from exc
+    except SOLVER_FAILURES as exc:  # non-finite values reached the compiled solver: the solution diverged
+        raise ModelError(f"{scenario.source}: the solution diverged: the solver met non-finite values "
+                         f"({type(exc).__name__}: {exc}); likely cause: {likely_cause(scenario, road, solver)}"
+                         ) from exc

@@ -10,19 +10,34 @@ here prints.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
+import signal
+import sys
+import threading
 import time
 import traceback
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
-from typing import Any, Callable
+from typing import Any
 
-from cosim.errors import ConfigError, CosimError
+from cosim.errors import ConfigError, CosimError, Interrupted, interruption
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
-from cosim.study.folder import LOG_FILE, PLOTS_FOLDER, RESULT_FILE, RUNS_FOLDER, SCENARIO_FILE, STUDY_FILE, write_file
+from cosim.study.folder import (
+    LOG_FILE,
+    PLOTS_FOLDER,
+    RESULT_FILE,
+    RUNS_FOLDER,
+    SCENARIO_FILE,
+    STOP_FILE,
+    STUDY_FILE,
+    STUDY_ID_FILE,
+    write_file,
+)
 from cosim.study.logs import log_is_complete
 from cosim.study.spec import RunTask, Study, error_text
 from cosim.study.table import base_row, jsonable_row, plot_study, run_statistics, table_frame, write_table
@@ -30,6 +45,7 @@ from cosim.study.table import base_row, jsonable_row, plot_study, run_statistics
 __all__ = [
     "Progress",
     "StudyOutcome",
+    "check_study_folder",
     "default_workers",
     "execute_run",
     "finished_row",
@@ -39,6 +55,15 @@ __all__ = [
 
 #: How long to wait for a remote scheduler to have a worker, s.
 WORKER_WAIT = 60.0
+#: How often a run on a worker looks for the study's stop file, s of wall time.
+STOP_CHECK_EVERY = 0.5
+#: How long a stopped study waits for the runs in progress to finish their logs, s.
+STOP_WAIT = 30.0
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 log = logging.getLogger(__name__)
 
@@ -57,7 +82,11 @@ def execute_run(task: RunTask) -> dict[str, Any]:
     """
     started = time.perf_counter()
     folder = Path(task.folder)
+    stop = folder.parent.parent / STOP_FILE  # <output>/runs/<run id> -> <output>/.stop
     row = base_row(task)
+    if stop.exists():  # the study was stopped before this run began: nothing to do
+        row["status"], row["error"] = "interrupted", "the study was stopped before this run began"
+        return jsonable_row(row)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         (folder / RESULT_FILE).unlink(missing_ok=True)
@@ -71,12 +100,15 @@ def execute_run(task: RunTask) -> dict[str, Any]:
         write_file(folder / SCENARIO_FILE, task.scenario_text)
         scenario = load_scenario(folder / SCENARIO_FILE)
         bridge = scenario.build_bridge()
-        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge)
+        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge, progress=_StopCheck(stop))
         row.update(run_statistics(scenario, bridge, outcome, task.percentiles))
         row["status"] = "ok"
         row["error"] = ""
-    except KeyboardInterrupt:
-        raise
+    except KeyboardInterrupt as exc:
+        if not stop.exists():
+            raise  # a signal to this process (a study run in-process): the study stops
+        # Stopped by the study (on a worker): the log is finished, status "interrupted"; not a result.
+        row["status"], row["error"] = "interrupted", f"stopped by {interruption(exc)[1]}"
     except Exception as exc:  # noqa: BLE001 - a failing run is recorded, the study goes on
         row["status"] = "error"
         row["error"] = error_text(exc)
@@ -91,6 +123,32 @@ def execute_run(task: RunTask) -> dict[str, Any]:
         row["status"] = "error"
         row["error"] = error_text(exc)
     return row
+
+
+class _StopCheck:
+    """A run's progress callback that stops it (with a finished log) once the study's stop file appears.
+
+    A run on a Dask worker cannot be reached by the signal that stops the
+    study; the file in the shared output folder can. Checked at most every
+    :data:`STOP_CHECK_EVERY` seconds of wall time.
+    """
+
+    def __init__(self, stop: Path) -> None:
+        self.stop = stop
+        self._next = time.monotonic() + STOP_CHECK_EVERY
+
+    def __call__(self, fraction: float) -> None:
+        now = time.monotonic()
+        if now < self._next:
+            return
+        self._next = now + STOP_CHECK_EVERY
+        if self.stop.exists():
+            try:
+                name = self.stop.read_text(encoding="utf-8").strip()[:20] or "SIGTERM"
+            except OSError:
+                name = "SIGTERM"
+            signum = signal.Signals[name] if name in signal.Signals.__members__ else signal.SIGTERM
+            raise Interrupted(int(signum), f"{name} to the study")
 
 
 def finished_row(task: RunTask) -> dict[str, Any] | None:
@@ -216,9 +274,12 @@ def run_study(
     """
     started = time.perf_counter()
     output = study.output
+    check_study_folder(study)
     try:
         output.mkdir(parents=True, exist_ok=True)
         write_file(output / STUDY_FILE, study.text)
+        write_file(output / STUDY_ID_FILE, json.dumps({"name": study.name, "source": _source(study)}, indent=1))
+        (output / STOP_FILE).unlink(missing_ok=True)  # left by a study killed while it was stopping
     except OSError as exc:
         raise CosimError(f"{output}: cannot write the study's output folder ({exc.strerror or exc})") from None
     tasks = study.tasks()
@@ -249,11 +310,14 @@ def run_study(
             else:
                 used = _run_on_dask(study, todo, workers, scheduler, finished)
     except KeyboardInterrupt:
-        # Runs that finished on a worker but whose result had not come back yet count too.
+        # The table of the runs completed so far (ok or failed); runs that finished on a worker but
+        # whose result had not come back yet count too; runs stopped half-way do not.
         for task in todo:
             if task.run_id not in rows and (stored := finished_row(task)) is not None:
                 rows[task.run_id] = stored
-        write_table([rows[t.run_id] for t in tasks if t.run_id in rows], output)
+        completed = [rows[t.run_id] for t in tasks
+                     if t.run_id in rows and rows[t.run_id].get("status") in ("ok", "error")]
+        write_table(completed, output)
         raise
     ordered = [rows[t.run_id] for t in tasks]
     csv_path, parquet_path = write_table(ordered, output)
@@ -286,8 +350,9 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
                                  "start some with: dask worker ADDRESS --nthreads 1)") from None
         else:
             n = min(workers or default_workers(), len(todo))
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                   silence_logs=logging.ERROR)
+            with _terminal_signals_ignored():  # the worker processes start with these ignored
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
             client = Client(cluster)
     except BaseException:
         if cluster is not None:
@@ -311,6 +376,9 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
                 except Exception as exc:  # noqa: BLE001 - e.g. the worker died (KilledWorker)
                     row = _lost_row(task, exc)
                 finished(row)
+        except KeyboardInterrupt as exc:
+            _stop_runs(client, futures, by_key, study.output / STOP_FILE, interruption(exc)[1], finished)
+            raise
         except BaseException:
             client.cancel(futures)
             raise
@@ -319,6 +387,93 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop: Path, name: str,
+               finished: Callable[[dict[str, Any]], None]) -> None:
+    """Stop a study on Dask: runs not yet begun are cancelled, runs in progress stop with finished logs.
+
+    The stop file tells the runs on the workers (which the signal does not
+    reach) to stop at their next block; they come back within a second or two
+    with status "interrupted" (not a result: the same command runs them again).
+    Runs that completed meanwhile are handed to ``finished``. A second signal
+    while waiting stops the waiting.
+    """
+    from dask.distributed import wait
+
+    try:
+        stop.write_text(name, encoding="utf-8")
+    except OSError:
+        client.cancel(futures)
+        return
+    try:
+        try:
+            assigned = {key for keys in client.processing().values() for key in keys}
+        except Exception:  # noqa: BLE001 - the scheduler is gone: nothing to wait for
+            assigned = set()
+        client.cancel([f for f in futures if str(f.key) not in assigned and not f.done()])
+        running = [f for f in futures if str(f.key) in assigned]
+        wait(running, timeout=STOP_WAIT)
+        for future in running:
+            if future.done() and future.status == "finished":
+                row = future.result()
+                if row.get("status") in ("ok", "error"):
+                    finished(row)
+    finally:
+        with contextlib.suppress(OSError):
+            stop.unlink()
+
+
+@contextlib.contextmanager
+def _terminal_signals_ignored() -> Iterator[None]:
+    """SIGINT and SIGHUP ignored while worker processes start, so that they inherit it.
+
+    Ctrl-C (or a closed terminal) signals every process of the terminal's
+    group: the workers would die with tracebacks. The study's own process
+    handles the signal and stops the runs on them (:func:`_stop_runs`).
+    Only in the main thread; a signal in these few seconds is lost.
+    """
+    names = [n for n in ("SIGINT", "SIGHUP") if hasattr(signal, n)]
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {name: signal.signal(getattr(signal, name), signal.SIG_IGN) for name in names}
+    try:
+        yield
+    finally:
+        for name, handler in old.items():
+            signal.signal(getattr(signal, name), handler)
+
+
+def check_study_folder(study: Study) -> None:
+    """Refuse an output folder that holds another study: its ``study.toml`` and table would be replaced.
+
+    The folder's ``study.json`` names its study; a folder from before it was
+    written is judged by ``[study].name`` in its ``study.toml``, if given.
+
+    Raises:
+        CosimError: the folder belongs to a study of another name, or is not a folder.
+    """
+    output = study.output
+    if output.exists() and not output.is_dir():
+        raise CosimError(f"{output}: is a file, expected the study's output folder")
+    owner: str | None = None
+    try:
+        owner = json.loads((output / STUDY_ID_FILE).read_text(encoding="utf-8")).get("name")
+    except (OSError, ValueError, AttributeError):
+        try:
+            with open(output / STUDY_FILE, "rb") as handle:
+                owner = tomllib.load(handle).get("study", {}).get("name")
+        except (OSError, ValueError, AttributeError):
+            owner = None
+    if isinstance(owner, str) and owner != study.name:
+        raise CosimError(f"{output}: holds the results of study {owner!r}, not {study.name!r}; refusing to replace "
+                         "its study.toml and table: give another --out (a study's folder holds one study)")
+
+
+def _source(study: Study) -> str:
+    path = Path(study.source)
+    return str(path.resolve()) if path.is_file() else study.source
 
 
 def _lost_row(task: RunTask, exc: BaseException) -> dict[str, Any]:

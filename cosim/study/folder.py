@@ -4,6 +4,7 @@
 
     <output>/
       study.toml                 the study file, as given
+      study.json                 whose folder this is: the study's name and file
       results.csv, results.parquet
       plots/<column>.png
       runs/<run id>/
@@ -15,7 +16,9 @@
 """
 from __future__ import annotations
 
+import contextlib
 import os
+import secrets
 from pathlib import Path
 
 __all__ = [
@@ -24,7 +27,9 @@ __all__ = [
     "RESULT_FILE",
     "RUNS_FOLDER",
     "SCENARIO_FILE",
+    "STOP_FILE",
     "STUDY_FILE",
+    "STUDY_ID_FILE",
     "SUMO_FOLDER",
     "TABLE_CSV",
     "TABLE_PARQUET",
@@ -32,6 +37,10 @@ __all__ = [
 ]
 
 STUDY_FILE = "study.toml"
+#: Which study the folder belongs to (a study's folder holds one study: --out into another's is refused).
+STUDY_ID_FILE = "study.json"
+#: Present while a stopped study asks its runs on the workers to stop (holds the signal's name).
+STOP_FILE = ".stop"
 RUNS_FOLDER = "runs"
 SUMO_FOLDER = "sumo"
 SCENARIO_FILE = "scenario.toml"
@@ -43,10 +52,18 @@ PLOTS_FOLDER = "plots"
 
 
 def write_file(path: Path, data: bytes | str) -> None:
-    """Write through a temporary file, so a reader never sees half a file (text as UTF-8)."""
+    """Write through a temporary file in the same folder, flushed to disk and renamed over ``path``:
+    a reader never sees half a file, and a failure (or a signal) leaves ``path`` as it was."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(path.name + ".part")
+    partial = path.with_name(f".{path.name}.{secrets.token_hex(4)}.part")
     if isinstance(data, str):
         data = data.encode("utf-8")
-    partial.write_bytes(data)
-    os.replace(partial, path)
+    try:
+        with open(partial, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(partial, path)
+    finally:
+        with contextlib.suppress(OSError):
+            partial.unlink(missing_ok=True)

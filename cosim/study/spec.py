@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import itertools
+import math
 import os
 import re
 import sys
@@ -20,6 +21,7 @@ from typing import Annotated, Any
 
 from pydantic import Field, PlainValidator, Strict, ValidationError, field_validator
 
+from cosim.core.limits import MAX_RUNS
 from cosim.core.roughness import ISO_CLASSES as ISO_ROAD_CLASSES
 from cosim.errors import ConfigError, CosimError
 from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
@@ -97,6 +99,10 @@ def _seeds(value: Any) -> tuple[int, ...]:
     if isinstance(value, int) and not isinstance(value, bool):
         if value < 1:
             raise fail(f"a count of seeds must be >= 1 (got {value})")
+        limit = MAX_RUNS.value()
+        if value > limit:  # before the tuple of seeds is built
+            raise fail(f"{value:,} seeds is more than the limit of {limit:,} runs for one study; "
+                       f"{MAX_RUNS.how_to_raise()}")
         return tuple(range(1, value + 1))
     if not isinstance(value, (list, tuple)):
         raise fail(f"expected an array of integers >= 0 (or a count), got {show(value)}")
@@ -385,6 +391,8 @@ def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[
         values = getattr(sweep, "seeds" if axis == "seed" else axis)
         if values is not None:
             axes[axis] = tuple(values)
+    runs = math.prod(len(values) for values in axes.values())
+    MAX_RUNS.check(runs, f"{source}: sweep", " x ".join(f"{len(v)} {axis}" for axis, v in axes.items()))
     has_traffic = "traffic" in base_data
     if "vehicles" in base_data or not has_traffic:
         for axis in SUMO_AXES:

@@ -17,20 +17,25 @@ SUMO's files in :mod:`cosim.sumo.files`.
 """
 from __future__ import annotations
 
+import contextlib
+import difflib
 import functools
 import math
 import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any, Callable, Sequence
+from typing import Any
 
 import numpy as np
 
 from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError
-from cosim.sumo.files import distribution_ids
+from cosim.sumo.files import DEMAND_OPTIONS, distribution_ids, parse_xml, read_config, read_input
 from cosim.sumo.vtypes import PARAM_KEYS, PARAM_PREFIX, axles_from_parameters, model_from_parameters, scaled_model
 
 __all__ = ["WATCH_MARGIN", "BridgeAxis", "SumoTraffic", "bundled_networks", "sumo_binary"]
@@ -143,10 +148,12 @@ class SumoTraffic:
             *(["--seed", str(self.seed)] if self.seed is not None else []),
             *self.extra_args,
         ]
-        try:
-            libsumo.start(cmd)
-        except Exception as exc:  # libsumo raises its own error types with SUMO's message
-            raise SumoError(f"{self.config}: SUMO could not load it: {_first_line(exc)}") from None
+        check_vtype_params(self.config)
+        with _stderr_captured() as captured:
+            try:
+                libsumo.start(cmd)
+            except Exception as exc:  # libsumo raises its own error types; SUMO printed the reason
+                raise SumoError(f"{self.config}: SUMO could not load it: {_sumo_reason(captured(), exc)}") from None
         try:
             self._watch()
             # Every vType known at the start is turned into its vehicle model now, so that an
@@ -307,6 +314,98 @@ class SumoTraffic:
         out = self.frames.block(times)
         self.frames.forget_before(float(times[-1]))
         return out
+
+
+@contextlib.contextmanager
+def _stderr_captured() -> Iterator[Callable[[], str]]:
+    """Within the block, what is written to file descriptor 2 (SUMO's C++ error output) goes to a
+    temporary file; yields a function that returns it. Written back to stderr when the block ends
+    normally, so nothing is lost; on an error the caller words it into its one line instead."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        text: list[str] = []
+
+        def captured() -> str:
+            if not text:
+                sink.seek(0)
+                text.append(sink.read(1 << 16).decode("utf-8", "replace"))
+            return text[0]
+
+        failed = True
+        try:
+            yield captured
+            failed = False
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            if not failed and captured().strip():
+                print(captured().rstrip(), file=sys.stderr)
+
+
+def _sumo_reason(output: str, exc: BaseException) -> str:
+    """SUMO's own reason, from what it printed ("Error: ..." and the lines below it), on one line."""
+    lines = [line.strip() for line in output.splitlines()]
+    starts = [i for i, line in enumerate(lines) if line.startswith("Error:")]
+    if not starts:
+        return _first_line(exc)
+    first = starts[0]
+    detail = [lines[first][len("Error:"):].strip()]
+    for line in lines[first + 1:]:
+        if not line or line.startswith(("Error:", "Quitting", "Warning:")):
+            break
+        detail.append(line[0].lower() + line[1:])
+    return " ".join(part.rstrip(".") for part in detail if part)
+
+
+def check_vtype_params(config: str | os.PathLike) -> None:
+    """Every ``cosim.*`` param of every vType in a config's demand files is one cosim reads, for its model.
+
+    A misspelled key (``cosim.kv``) would otherwise leave the vClass default in
+    place, and ``cosim.k_t`` on a quarter-car would be ignored. Lenient about
+    files it cannot read (SUMO, which loads them next, judges those).
+
+    Raises:
+        SumoError: one line naming the file, the vType and the key, with the keys it may be.
+    """
+    try:
+        parsed = read_config(Path(config))
+    except ConfigError:
+        return
+    for path in parsed.files(DEMAND_OPTIONS):
+        try:
+            root = parse_xml(read_input(path), str(path))
+        except ConfigError:
+            continue
+        for vtype in root.iter("vType"):
+            params = {p.get("key", ""): p.get("value", "") for p in vtype.iter("param")}
+            model = params.get(PARAM_PREFIX + "model", "quarter-car")
+            allowed = _MODEL_PARAMS.get(model)
+            if allowed is None:
+                continue  # an unknown model: model_from_parameters names it
+            for key in params:
+                if not key.startswith(PARAM_PREFIX):
+                    continue
+                name = key[len(PARAM_PREFIX):]
+                if name in allowed:
+                    continue
+                where = f"{path}: vType {vtype.get('id', '?')}: param `{key}`"
+                if name in PARAM_KEYS:
+                    raise SumoError(f"{where} is not used by model {model} (its params: "
+                                    + ", ".join(PARAM_PREFIX + k for k in allowed) + ")")
+                near = difflib.get_close_matches(name, PARAM_KEYS, n=1)
+                hint = f"; did you mean `{PARAM_PREFIX}{near[0]}`?" if near else ""
+                raise SumoError(f"{where} is not a cosim param{hint} (cosim reads: "
+                                + ", ".join(PARAM_PREFIX + k for k in PARAM_KEYS) + ")")
+
+
+#: The ``cosim.*`` params each vehicle model uses (the others would be ignored: an error).
+_MODEL_PARAMS: dict[str, tuple[str, ...]] = {
+    "quarter-car": ("model", "m_w", "k_v", "c_v", "axles", "axle_loads"),
+    "tyre-quarter-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads"),
+    "moving-force": ("model", "axles", "axle_loads"),
+}
 
 
 def _first_line(exc: BaseException) -> str:

@@ -6,6 +6,7 @@ import io
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 from _cli import TWO_CARS, cosim_cli
 
@@ -163,7 +164,8 @@ def test_vehicle_entering_after_the_run_is_reported(tmp_path: Path, capsys: pyte
 
 def test_divergence_exits_1_with_a_finished_log(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                capsys: pytest.CaptureFixture[str]) -> None:
-    def diverge(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+    def diverge(bridge, traffic, *args, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        traffic.block(np.array([0.002]))  # the time stepping starts, then fails
         raise ModelError("the solution diverged at t = 1.234 s (non-finite bridge acceleration)")
 
     monkeypatch.setattr(runner, "simulate", diverge)
@@ -172,7 +174,8 @@ def test_divergence_exits_1_with_a_finished_log(tmp_path: Path, monkeypatch: pyt
     assert run_main(str(path), "--out", str(out), "--csv", str(table), "--quiet") == 1
     err = capsys.readouterr().err
     assert err.startswith(f"cosim: error: {path}: the solution diverged at t = 1.234 s")
-    assert f'the log {out} is finished and ends with status "error"' in err and "Traceback" not in err
+    assert "likely cause" in err and f'its log {out} is finished, status "error"' in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     status = read_log(out).final_status
     assert status["state"] == "error" and "diverged at t = 1.234 s" in status["message"]
     assert not table.exists()
@@ -180,7 +183,8 @@ def test_divergence_exits_1_with_a_finished_log(tmp_path: Path, monkeypatch: pyt
 
 def test_interrupt_exits_130_with_a_finished_log(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
                                                 capsys: pytest.CaptureFixture[str]) -> None:
-    def interrupted(*args, progress=None, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+    def interrupted(bridge, traffic, *args, progress=None, **kwargs):  # noqa: ANN001, ANN002, ANN003, ANN202
+        traffic.block(np.array([0.002]))  # the time stepping starts
         progress(0.25)
         raise KeyboardInterrupt
 
@@ -189,7 +193,7 @@ def test_interrupt_exits_130_with_a_finished_log(tmp_path: Path, monkeypatch: py
     out = tmp_path / "o.mcap"
     assert run_main(str(path), "--out", str(out)) == 130
     err = capsys.readouterr().err
-    assert err.splitlines()[-1] == (f"cosim: interrupted at about t = 1 s of 4 s; the log up to there is in {out} "
+    assert err.splitlines()[-1] == (f"cosim: interrupted by SIGINT at about t = 1 s of 4 s; the log up to there is in {out} "
                                     '(finished, status "interrupted")')
     log = read_log(out)
     assert not log.truncated and log.final_status["state"] == "interrupted"

@@ -825,7 +825,7 @@ def test_road_profile_file_is_relative_to_the_scenario(tmp_path: Path, monkeypat
     [
         ("x,r\n0.0,0.0\n10.0,0.001\n", ["the profile covers 0 <= x <= 10 m", "must cover the deck, 0 <= x <= 22 m"]),
         ("x,r\n0.0,0.0\n__import__('os').system('true'),0\n30,0\n", ["line 3: expected two numbers"]),
-        ("x,r\n0.0,0.0\n30,0\n20,0\n", ["x must be finite and strictly increasing"]),
+        ("x,r\n0.0,0.0\n30,0\n20,0\n", ["line 4: x must increase strictly"]),
     ],
     ids=["too-short", "not-a-number", "x-decreasing"],
 )
