@@ -81,6 +81,9 @@ _PURE_KIND_SHARE = 0.75
 MECHANISM_PIVOT = 1e-11
 
 SupportSpec = Union[str, Sequence[str]]
+#: Stress resultants :meth:`BridgeModel.field_row` gives (docs/theory.md §12.2).
+RESULTANTS: tuple[str, ...] = ("axial_force", "bending_moment", "shear_force_y", "shear_force_z", "torque_sv",
+                               "bimoment")
 
 
 @dataclass(frozen=True)
@@ -355,32 +358,58 @@ class BridgeModel:
         dofs = NODE_DOFS * e[:, None] + np.arange(ELEMENT_DOFS)[None, :]
         return dofs, values
 
-    def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0) -> DeckRow:
+    def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0, *, z: float = 0.0,
+                  omega: float = 0.0) -> DeckRow:
         """Row mapping the element DOFs at ``x`` (m) to a field value.
 
         ``name`` is one of u, v, w, theta_x, theta_y, theta_z, psi (interpolated with
         the element's shape functions; psi = theta_x' for Vlasov torsion), ``w_deck`` (the
         vertical displacement of the deck point at lateral position ``y``, m),
-        or ``bending_moment`` (vertical bending moment about the centroidal y
+        ``bending_moment`` (vertical bending moment about the centroidal y
         axis, N m, sagging positive: ``M = -E (I_y theta_y' - I_yz theta_z')``,
-        which is ``E I_y w''`` for Euler-Bernoulli bending). ``order`` adds
-        x-derivatives. Only ``values[0]`` of the returned row is filled.
+        which is ``E I_y w''`` for Euler-Bernoulli bending), or one of the
+        stress resultants and the strain of docs/theory.md §12:
+
+        - ``axial_force`` ``N = E A u'`` (N, tension positive);
+        - ``shear_force_y`` ``V_y = -E (I_z theta_z'' - I_yz theta_y'')`` and
+          ``shear_force_z`` ``V_z = E (I_y theta_y'' - I_yz theta_z'')`` (N, on the
+          face whose outward normal is +x, along +y and +z; from equilibrium
+          with the bending moments, so they hold for both bending theories);
+        - ``torque_sv`` ``T_sv = G J theta_x'`` (N m, the St Venant part of the torque);
+        - ``bimoment`` ``B = -E I_w psi'`` (N m^2; ``sigma = B omega / I_w``);
+        - ``normal_strain`` ``eps_x = u' + (z - z_c) theta_y' - (y - y_c) theta_z' - omega psi'``
+          at the section point ``(y, z)`` whose sectorial coordinate is ``omega`` (m^2).
+
+        ``order`` adds x-derivatives. Only ``values[0]`` of the returned row is filled.
         """
         e, xi = self.locate(x)
         lengths, phi_y, phi_z, phi_t = self._element_data
-        extra = 1 if name == "bending_moment" else 0
+        extra = {"bending_moment": 1, "axial_force": 1, "torque_sv": 1, "bimoment": 1, "normal_strain": 1,
+                 "shear_force_y": 2, "shear_force_z": 2}.get(name, 0)
         n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra, phi_t[e])[0]
+        sec, mat = self.section, self.material
+        ty, tz = n[FIELD_INDEX["theta_y"]], n[FIELD_INDEX["theta_z"]]
         if name == "bending_moment":
-            sec = self.section
-            row = -self.material.E * (sec.I_y * n[FIELD_INDEX["theta_y"]] - sec.I_yz * n[FIELD_INDEX["theta_z"]])
+            row = -mat.E * (sec.I_y * ty - sec.I_yz * tz)
+        elif name == "shear_force_z":
+            row = mat.E * (sec.I_y * ty - sec.I_yz * tz)
+        elif name == "shear_force_y":
+            row = -mat.E * (sec.I_z * tz - sec.I_yz * ty)
+        elif name == "axial_force":
+            row = mat.E * sec.A * n[FIELD_INDEX["u"]]
+        elif name == "torque_sv":
+            row = mat.G * sec.J * n[FIELD_INDEX["theta_x"]]
+        elif name == "bimoment":
+            row = -mat.E * sec.I_w * n[FIELD_INDEX["psi"]]
+        elif name == "normal_strain":
+            row = (n[FIELD_INDEX["u"]] + (z - sec.z_c) * ty - (y - sec.y_c) * tz - omega * n[FIELD_INDEX["psi"]])
         elif name == "w_deck":
             row = n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]
         elif name in FIELD_INDEX:
             row = n[FIELD_INDEX[name]]
         else:
-            raise ModelError(
-                f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, w_deck, bending_moment)"
-            )
+            raise ModelError(f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, w_deck, "
+                             f"{', '.join(RESULTANTS)}, normal_strain)")
         return DeckRow(dofs=self._element_dofs(e), values=row[None, :])
 
     def field(
