@@ -28,6 +28,7 @@ from cosim.analysis.fatigue import (
     miner_damage,
     sn_curve,
     sn_curve_names,
+    turning_points,
 )
 
 __all__ = [
@@ -46,4 +47,5 @@ __all__ = [
     "peaks_over_threshold",
     "sn_curve",
     "sn_curve_names",
+    "turning_points",
 ]

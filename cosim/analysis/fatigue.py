@@ -32,6 +32,7 @@ __all__ = [
     "miner_damage",
     "sn_curve",
     "sn_curve_names",
+    "turning_points",
 ]
 
 #: A Julian year, s: what "per year" means here.
@@ -263,3 +264,23 @@ def fatigue(history: npt.ArrayLike, curve: SNCurve, duration: float, *, vehicles
 def damage_of_ranges(ranges: Sequence[float], counts: Sequence[float], curve: SNCurve) -> float:
     """Miner damage of given (range, count) pairs: what a hand calculation does."""
     return miner_damage(Cycles(np.asarray(ranges, float), np.zeros(len(ranges)), np.asarray(counts, float)), curve)
+
+
+def turning_points(values: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """The first and last values and every local extremum in between: all a rainflow count needs.
+
+    Reducing consecutive pieces of a history this way and joining them keeps
+    every reversal of the whole (a reversal is either inside a piece or at its
+    ends), so a long run's history never has to be held in memory.
+    """
+    y = np.asarray(values, dtype=float).ravel()
+    if len(y) <= 2:
+        return y.copy()
+    d = np.diff(y)
+    nonzero = np.flatnonzero(d != 0)
+    if len(nonzero) == 0:
+        return y[[0, -1]]
+    signs = np.sign(d[nonzero])
+    # A sample is a reversal where the sign of the next non-zero step changes.
+    flips = nonzero[1:][signs[1:] != signs[:-1]]
+    return np.concatenate([[y[0]], y[flips], [y[-1]]])

@@ -16,13 +16,14 @@ import platform
 import signal
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
 from cosim import __version__
+from cosim.analysis.fatigue import FatigueResult
 from cosim.core.bridge import BridgeModel
 from cosim.core.simulation import SimulationResult, simulate
 from cosim.errors import ConfigError, CosimError, LogError, ModelError, SumoError
@@ -34,12 +35,15 @@ from cosim.log.schemas import (
 )
 from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 
+from .engineering import FatigueRecorder, fatigue_payload, stress_curves
 from .inputs import input_files
 from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import Scenario
 from .simulate import build_traffic
 
+#: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
+FATIGUE_METADATA_NAME = "fatigue"
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
 #: How often a "running" status is logged, s of simulated time.
@@ -71,6 +75,8 @@ class RunOutcome:
         samples: sensor samples in the log (t = 0 included).
         wall_time: wall time of the whole logged run, s (time stepping and logging).
         log_bytes: size of the finished log.
+        fatigue: sensor name -> rainflow count and Miner damage of its logged samples (stress sensors with an
+            S-N curve; the damage per year for the run's traffic all year).
     """
 
     scenario: Scenario
@@ -83,6 +89,7 @@ class RunOutcome:
     samples: int
     wall_time: float
     log_bytes: int
+    fatigue: dict[str, FatigueResult] = field(default_factory=dict)
 
 
 class _DeckTimes:
@@ -230,6 +237,7 @@ def run_logged(
     }
     extremes = _DeckTimes()
     samples = _Samples()
+    fatigue = FatigueRecorder(names, stress_curves(scenario))
     wall_start = time.perf_counter()
     with _InterruptOnce() as guard, LogRecorder(log_path, names, force=force) as rec:
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
@@ -253,7 +261,7 @@ def run_logged(
                 if live_sumo:  # SUMO starts inside the log: a SUMO failure is the log's final status
                     traffic = stack.enter_context(build_traffic(scenario, frame_sink=TrafficLogger(rec)))
                 result = simulate(bridge, logger.paced(traffic), duration, solver=solver, sensors=sensors, road=road,
-                                  output_every=every, progress=progress, observers=[extremes, samples, logger],
+                                  output_every=every, progress=progress, observers=[extremes, samples, fatigue, logger],
                                   collect=False)
                 guard.closing = True  # a Ctrl-C from here on must not cut the log's ending short
         except KeyboardInterrupt:
@@ -271,10 +279,14 @@ def run_logged(
             if isinstance(exc, SumoError) and getattr(traffic, "sumo_steps", 0) > 0:
                 raise RunFailed(f"{scenario.source}: {exc}", log_path) from exc  # SUMO failed mid-run
             raise
+        damage = fatigue.results(duration, len(result.vehicle_ids))
+        if damage:
+            payload = fatigue_payload(damage)
+            rec.metadata(FATIGUE_METADATA_NAME, {k: json.dumps(jsonable(v)) for k, v in payload.items()})
         wall = time.perf_counter() - wall_start
         rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
     return RunOutcome(
         scenario=scenario, log_path=log_path, result=result, duration=duration, every=every, rate_hz=rate_hz,
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,
-        wall_time=wall, log_bytes=log_path.stat().st_size,
+        wall_time=wall, log_bytes=log_path.stat().st_size, fatigue=damage,
     )
