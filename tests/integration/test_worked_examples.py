@@ -41,7 +41,8 @@ def _fatpack_damage(history, category):
     cycles, residue = fatpack.find_rainflow_cycles(y[keep])
     ranges = np.abs(cycles[:, 1] - cycles[:, 0]) / 1e6 if len(cycles) else np.zeros(0)
     half = np.abs(np.diff(residue)) / 1e6
-    pairs = np.column_stack([np.concatenate([ranges, half]), np.concatenate([np.ones(len(ranges)), 0.5 * np.ones(len(half))])])
+    counts = np.concatenate([np.ones(len(ranges)), 0.5 * np.ones(len(half))])
+    pairs = np.column_stack([np.concatenate([ranges, half]), counts])
     return fatpack.TriLinearEnduranceCurve(float(category)).find_miner_sum(pairs)
 
 
