@@ -9,8 +9,9 @@ from __future__ import annotations
 import itertools
 import os
 import re
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -534,7 +535,7 @@ def validation_mesh(
         n, err = np.asarray(n), np.asarray(err, dtype=float)
         ax.loglog(n, err, "o-", color=f"C{k}", ms=4, label=label)
         ax.loglog(n, err[0] * (n / n[0]) ** -order, "--", color=f"C{k}", lw=0.8, label=f"slope {order:g}")
-    _validation_log_ticks(ax, sorted({int(n) for group in counts for n in group}))
+    _validation_log_ticks(ax, sorted({int(n) for group in counts for n in np.asarray(group)}))
     ax.set_xlabel("elements in the span [-]")
     ax.set_ylabel("relative error of the first vertical frequency [-]")
     ax.set_title(title, fontsize=10)
@@ -557,4 +558,88 @@ def validation_parked(
     ax.set_ylabel("deflection w [mm]")
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
+    return _validation_save(fig, path)
+
+
+def validation_benscoter(
+    path: str | Path, *, static_title: str, x: npt.ArrayLike, warping: Sequence[str], closed: Sequence[npt.ArrayLike],
+    vlasov: Sequence[npt.ArrayLike], nodes_x: npt.ArrayLike, fe: Sequence[npt.ArrayLike], frequency_title: str,
+    modes: npt.ArrayLike, f_vlasov: npt.ArrayLike, f_ref: npt.ArrayLike, f_fe: npt.ArrayLike, n_elements: int,
+    mesh_label: str, counts: npt.ArrayLike, errors: npt.ArrayLike, expected_order: float,
+) -> Path:
+    """Benscoter torsion: twist (rad) under a mid-span torque, torsional frequencies (Hz), mesh convergence."""
+    fig, axes = _validation_figure(1, 3, size=(14.0, 4.2))
+    ax = axes[0, 0]
+    for k, (name, line, line_vlasov, nodal) in enumerate(zip(warping, closed, vlasov, fe)):
+        ax.plot(x, 1e3 * np.asarray(line), "-", color=f"C{k}", label=f"closed form, warping {name}")
+        ax.plot(x, 1e3 * np.asarray(line_vlasov), ":", color=f"C{k}", label=f"Vlasov (ψ = θx'), warping {name}")
+        ax.plot(nodes_x, 1e3 * np.asarray(nodal), "o", ms=3.0, mfc="none", color=f"C{k}", label=f"FE nodes, {name}")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("twist θx [mrad]")
+    ax.set_title(static_title, fontsize=10)
+    ax.legend(fontsize=6)
+    ax = axes[0, 1]
+    ax.plot(modes, f_vlasov, "s:", color="0.5", label="Vlasov frequency equation")
+    ax.plot(modes, f_ref, "-", color="C0", label="Benscoter frequency equation")
+    ax.plot(modes, f_fe, "o", mfc="none", color="C0", label=f"FE, {n_elements} elements")
+    ax.set_xticks(list(np.asarray(modes)))
+    ax.set_xlabel("torsional mode n [-]")
+    ax.set_ylabel("frequency [Hz]")
+    ax.set_title(frequency_title, fontsize=10)
+    ax.legend(fontsize=7)
+    ax = axes[0, 2]
+    counts, errors = np.asarray(counts), np.asarray(errors, dtype=float)
+    ax.loglog(counts, errors, "o-", color="C0", ms=4, label=mesh_label)
+    ax.loglog(counts, errors[0] * (counts / counts[0]) ** -expected_order, "--", color="0.5", lw=0.8,
+              label=f"slope {expected_order:g}")
+    _validation_log_ticks(ax, [int(n) for n in counts])
+    ax.set_xlabel("elements [-]")
+    ax.set_ylabel("relative error [-]")
+    ax.set_title("Mesh convergence", fontsize=10)
+    ax.legend(fontsize=7)
+    return _validation_save(fig, path)
+
+
+def validation_paper_theories(
+    path: str | Path, *, title: str, node_titles: Sequence[str], theories: Sequence[str], torsion_1: Sequence[float],
+    t: Sequence[npt.ArrayLike], w: Sequence[npt.ArrayLike], duration: float,
+) -> Path:
+    """The paper case under moving forces with each torsion theory: mid-span histories (m), one panel per node."""
+    fig, axes = _validation_figure(1, len(node_titles), size=(14.0, 4.0), sharey=True)
+    styles = ("-", "--", ":", "-.")
+    for i, node_title in enumerate(node_titles):
+        ax = axes[0, i]
+        for name, style, f1, t_theory, w_theory in zip(theories, itertools.cycle(styles), torsion_1, t, w):
+            ax.plot(t_theory, 1e3 * np.asarray(w_theory)[i], style, lw=1.2, label=f"{name} (torsion-1 {f1:.3f} Hz)")
+        ax.set_xlabel("time t [s]")
+        ax.set_title(node_title, fontsize=10)
+        ax.set_xlim(0.0, duration)
+        ax.legend(fontsize=7, loc="lower left")
+    axes[0, 0].set_ylabel("vertical displacement w [mm]")
+    fig.suptitle(title, fontsize=10)
+    return _validation_save(fig, path)
+
+
+def validation_vbi2d(
+    path: str | Path, *, title: str, n_elements: int, ref_modes: int, t: npt.ArrayLike, w_fe: npt.ArrayLike,
+    w_ref: npt.ArrayLike, peak_t: float, peak_w: float, t_body: npt.ArrayLike, a_fe: npt.ArrayLike,
+    a_ref: npt.ArrayLike,
+) -> Path:
+    """VBI-2D's sprung vehicle: mid-span deflection (m) with the published peak (left), body acceleration (right)."""
+    fig, axes = _validation_figure(1, 2, size=(10.0, 4.0))
+    ax = axes[0, 0]
+    ax.plot(t, 1e3 * np.asarray(w_fe), "-", color="C0", lw=1.6, label=f"cosim, Euler-Bernoulli, {n_elements} elements")
+    ax.plot(t, 1e3 * np.asarray(w_ref), "--", color="k", lw=1.0, label=f"modal ODE ({ref_modes} modes, solve_ivp)")
+    ax.plot([peak_t], [1e3 * peak_w], "x", color="C3", ms=8,
+            label=f"VBI-2D peak ({1e3 * peak_w:.5f} mm, {peak_t:.3f} s)")
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("mid-span deflection w [mm]")
+    ax.legend(fontsize=7)
+    ax = axes[0, 1]
+    ax.plot(t_body, a_fe, "-", color="C1", lw=1.6, label="cosim")
+    ax.plot(t, a_ref, "--", color="k", lw=1.0, label="modal ODE")
+    ax.set_xlabel("time t [s]")
+    ax.set_ylabel("body acceleration [m/s²]")
+    ax.legend(fontsize=7)
+    fig.suptitle(title, fontsize=10)
     return _validation_save(fig, path)

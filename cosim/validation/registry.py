@@ -9,9 +9,10 @@ arguments it is called with.
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
-from typing import Any, Callable, Mapping, Sequence
+from typing import Any
 
 from cosim.errors import CosimError
 
@@ -54,7 +55,8 @@ class Study:
 
 
 #: Every study, in report order. Quick settings are coarser only where the full ones cost seconds
-#: (the Fryba steps; the sprung mass's steps and its reference's modes and rtol) and pass the same tolerances.
+#: (the Fryba steps; the sprung mass's steps and its reference's modes and rtol; the VBI-2D reference's modes
+#: and rtol) and pass the same tolerances.
 STUDIES: tuple[Study, ...] = (
     Study("paper", "Paper case: 40 m double-tee (Figs. 4-6)", cases.paper_case,
           quick={"dt": 0.005}, full={"dt": 0.005}),
@@ -74,6 +76,11 @@ STUDIES: tuple[Study, ...] = (
           quick={"length": 1000.0}, full={"length": 1000.0}),
     Study("mesh", "Mesh convergence", cases.mesh_convergence),
     Study("parked-vehicle", "Parked vehicle", cases.parked_vehicle),
+    Study("benscoter", "Shear-deformable warping (Benscoter)", cases.benscoter_torsion),
+    Study("paper-torsion-theories", "Paper case: Vlasov and Benscoter torsion", cases.paper_torsion_theories,
+          quick={"dt": 0.005}, full={"dt": 0.005}),
+    Study("vbi2d", "VBI-2D sprung vehicle (Euler-Bernoulli beam)", cases.vbi2d_sprung_vehicle,
+          quick={"modes": 10, "rtol": 1e-8}, full={"modes": 20, "rtol": 1e-10}),
 )
 
 

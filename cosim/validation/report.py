@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import time
 import traceback
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Callable, Sequence
 
 from cosim import __version__, plots
 from cosim.errors import CosimError
@@ -51,6 +51,9 @@ PLOTTERS: dict[type, Callable[..., Path]] = {
     cases.RoughnessFigure: plots.validation_roughness,
     cases.MeshFigure: plots.validation_mesh,
     cases.ParkedFigure: plots.validation_parked,
+    cases.BenscoterFigure: plots.validation_benscoter,
+    cases.PaperTheoriesFigure: plots.validation_paper_theories,
+    cases.Vbi2dFigure: plots.validation_vbi2d,
 }
 
 

@@ -9,9 +9,10 @@ verification tests assert on the same values.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from types import MappingProxyType
-from typing import Mapping, Union
+from typing import Union
 
 import numpy as np
 
@@ -34,10 +35,10 @@ def judge(error: float | None, tolerance: float) -> bool:
 
 @dataclass(frozen=True)
 class Table:
-    """A table of a case's numbers, cells already formatted (the report lays it out)."""
+    """A table of a case's numbers, cells already formatted (the report lays it out); stored as tuples."""
 
-    header: tuple[str, ...]
-    rows: tuple[tuple[str, ...], ...]
+    header: Sequence[str]
+    rows: Sequence[Sequence[str]]
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "header", tuple(self.header))

@@ -38,6 +38,9 @@ def test_the_brief_s_cases_are_all_there(report: ValidationReport) -> None:
         "lateral-torsional", "Fryba), α = 0.1", "Fryba), α = 0.5", "sprung mass: mid-span deflection",
         "sprung mass: body acceleration", "Energy conservation", "Time-step convergence",
         "roughness PSD, class A", "roughness PSD, class C", "Mesh convergence", "Parked vehicle",
+        "Benscoter torsion, mid-span torque, warping restrained", "Benscoter torsion, mid-span torque, warping free",
+        "Benscoter torsional frequencies", "Benscoter torsion, mesh convergence", "Vlasov vs Benscoter",
+        "VBI-2D sprung vehicle",
     ):
         assert expected in names, expected
 
@@ -61,7 +64,7 @@ def test_every_plot_is_a_real_png(report: ValidationReport) -> None:
     expected = {"paper_node1.png", "paper_node2.png", "paper_node3.png", "paper_asymmetric.png",
                 "timoshenko_static.png", "torsion_static.png", "fryba_moving_force.png", "sprung_mass.png",
                 "energy_drift.png", "time_step_convergence.png", "roughness_psd.png", "mesh_convergence.png",
-                "parked_vehicle.png"}
+                "parked_vehicle.png", "benscoter_torsion.png", "paper_torsion_theories.png", "vbi2d_sprung_mass.png"}
     assert {p.name for p in report.plots} == expected
     for plot in report.plots:
         assert plot.parent == report.out_dir
