@@ -571,6 +571,8 @@ def build_bridge(
     supports: Sequence[SupportSpec],
     damping: Union[RayleighDamping, ExplicitDamping, None] = None,
     theory: BeamTheory | None = None,
+    stiffness_factors: Sequence[float] | None = None,
+    support_springs: Sequence[tuple[int, str, float]] = (),
 ) -> BridgeModel:
     """Assemble a continuous beam bridge.
 
@@ -584,6 +586,12 @@ def build_bridge(
         damping: Rayleigh damping from two modes' ratios, explicit alpha/beta, or None.
         theory: torsion ("vlasov" | "benscoter") and bending ("timoshenko" |
             "euler-bernoulli") theories; default Vlasov and Timoshenko (the seed's element).
+        stiffness_factors: one factor per element (from x = 0) on its stiffness matrix: damage such as
+            cracking over a length of the deck (a factor 0.5 halves every stiffness of the element: E A,
+            E I, G A_s, G J, E I_w); default 1 everywhere. The mass is not changed. Stress rows still use
+            the material's E.
+        support_springs: (support line index, DOF name, stiffness) for a degraded support: that DOF of the
+            support line is no longer held but sits on a spring (N/m for translations, N m/rad for rotations).
 
     Returns:
         The assembled, immutable :class:`BridgeModel`.
@@ -616,6 +624,10 @@ def build_bridge(
     n_nodes = len(nodes_x)
     ndof = NODE_DOFS * n_nodes
     lengths = np.diff(nodes_x)
+    factors = np.ones(len(lengths)) if stiffness_factors is None else np.asarray(stiffness_factors, dtype=float)
+    if factors.shape != lengths.shape or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
+        raise ConfigError(f"`stiffness_factors` must be {len(lengths)} numbers > 0, one per element "
+                          f"(got {len(factors.ravel())})")
 
     # Element matrices depend only on the length: compute once per distinct length.
     cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -629,16 +641,29 @@ def build_bridge(
         dofs = NODE_DOFS * e + local
         rows.append(np.repeat(dofs, ELEMENT_DOFS))
         cols.append(np.tile(dofs, ELEMENT_DOFS))
-        kv.append(k_e.ravel())
+        kv.append(factors[e] * k_e.ravel())
         mv.append(m_e.ravel())
     rows_a, cols_a = np.concatenate(rows), np.concatenate(cols)
     K = sp.csr_matrix((np.concatenate(kv), (rows_a, cols_a)), shape=(ndof, ndof))
     M = sp.csr_matrix((np.concatenate(mv), (rows_a, cols_a)), shape=(ndof, ndof))
 
     support_nodes = np.concatenate([[0], np.cumsum(n_per)])
-    restrained = sorted(
-        {NODE_DOFS * int(node) + DOF_INDEX[name] for node, names in zip(support_nodes, support_sets) for name in names}
-    )
+    restrained_set = {NODE_DOFS * int(node) + DOF_INDEX[name]
+                      for node, names in zip(support_nodes, support_sets) for name in names}
+    springs = np.zeros(ndof)
+    for line, name, stiffness in support_springs:
+        if not (isinstance(line, (int, np.integer)) and 0 <= line < len(support_nodes)):
+            raise ConfigError(f"a support spring's support line must be 0 ... {len(support_nodes) - 1} (got {line!r})")
+        if name not in DOF_INDEX:
+            raise ConfigError(f"unknown DOF {name!r} of a support spring (expected one of: {', '.join(DOF_NAMES)})")
+        if not (np.isfinite(stiffness) and stiffness > 0):
+            raise ConfigError(f"a support spring's stiffness must be > 0 (got {stiffness!r})")
+        dof = NODE_DOFS * int(support_nodes[line]) + DOF_INDEX[name]
+        restrained_set.discard(dof)
+        springs[dof] += float(stiffness)
+    if np.any(springs):
+        K = (K + sp.diags(springs)).tocsr()
+    restrained = sorted(restrained_set)
     bridge = BridgeModel(
         spans=spans,
         nodes_x=nodes_x,
