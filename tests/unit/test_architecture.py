@@ -35,6 +35,7 @@ LAYERS = {
     "cosim.run": 3,
     "cosim.study": 4,
     "cosim.validation": 4,
+    "cosim.dataset": 4,
     "cosim.testing": 5,
     "cosim.cli": 6,
     "cosim.__main__": 7,
