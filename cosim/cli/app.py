@@ -40,11 +40,11 @@ from cosim.run.export import EXPORT_TOPICS
 from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
+from .dataset import cmd_dataset
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
 from .static import cmd_static
-from .dataset import cmd_dataset
 from .study import cmd_study
 from .text import EXIT_INTERRUPTED, EXIT_USAGE, report_error
 from .validate import cmd_validate
