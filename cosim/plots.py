@@ -242,6 +242,37 @@ def _sweep_panel(ax: Any, table: Any, axes: Mapping[str, Sequence[Any]], axis: s
         ax.legend(fontsize=7)
 
 
+# --------------------------------------------------------------------------- extremes
+
+
+def return_level_plot(samples_years: npt.ArrayLike, samples: npt.ArrayLike, curve_years: npt.ArrayLike,
+                      curve: npt.ArrayLike, target: tuple[float, float, float, float], *, label: str, title: str,
+                      path: str | Path) -> Path:
+    """A return-level plot: the fitted law's level against the return period (years, log scale), the data at
+    their plotting positions, and the target return level with its confidence interval.
+
+    Args:
+        samples_years, samples: the data's empirical return periods (years) and values, in display units.
+        curve_years, curve: the fitted return-level curve.
+        target: (return period, level, lower bound, upper bound) of the characteristic value.
+        label: the y-axis label (quantity and unit); title: the figure's title; path: the file.
+    """
+    years, level, lower, upper = target
+    fig = _figure(6.4, 4.2)
+    ax = fig.subplots()
+    ax.semilogx(curve_years, curve, "-", linewidth=1.4, label="fitted law")
+    ax.semilogx(samples_years, samples, "o", color="0.35", markersize=3.5, label="data (Gringorten positions)")
+    ax.errorbar([years], [level], yerr=[[level - lower], [upper - level]], fmt="s", color="C3", capsize=4,
+                label=f"{years:g}-year value {level:.4g} [{lower:.4g}, {upper:.4g}]")
+    ax.set_xlabel("return period [years]")
+    ax.set_ylabel(label, fontsize=9)
+    ax.grid(True, which="both", linewidth=0.4, alpha=0.5)
+    ax.legend(fontsize=7)
+    ax.set_title(title, fontsize=9)
+    _save(fig, path, dpi=110)
+    return Path(path)
+
+
 # --------------------------------------------------------------------------- validation
 #
 # One function per figure of ``cosim validate`` (:mod:`cosim.validation`): each takes the path

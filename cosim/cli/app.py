@@ -12,6 +12,7 @@ Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
     cosim plot LOG.mcap [--sensor NAME ...] -o FIG.png [--force]
     cosim validate [--out DIR] [--quick]
     cosim study STUDY.toml [--workers N] ...
+    cosim dataset SPEC.toml [--out FOLDER] [--force]
 
 The work is done by :mod:`cosim.run` (and :mod:`cosim.study`,
 :mod:`cosim.validation`); the command line parses, checks and prints, and is
@@ -39,6 +40,7 @@ from cosim.run.export import EXPORT_TOPICS
 from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
+from .dataset import cmd_dataset
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
@@ -410,6 +412,21 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--no-plots", action="store_true", help="write the table only")
     study.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     study.set_defaults(func=cmd_study)
+
+    dataset = commands.add_parser(
+        "dataset",
+        help="write a labelled monitoring dataset (healthy and damaged, temperature, instruments)",
+        description="Run a base scenario window by window for every damage case of the dataset file, measure the "
+                    "responses with its instruments (anti-aliasing, sampling, noise, quantisation) and write one "
+                    "row per window with its labels to dataset.parquet, plus the MCAP logs. docs/analysis.md "
+                    "documents the dataset file.",
+    )
+    dataset.add_argument("dataset", metavar="SPEC.toml", help="the dataset file")
+    dataset.add_argument("--out", metavar="FOLDER",
+                         help="the output folder (default: [dataset].output, else datasets/<name>)")
+    dataset.add_argument("--force", action="store_true", help="overwrite an existing dataset and its logs")
+    dataset.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
+    dataset.set_defaults(func=cmd_dataset)
     return parser
 
 

@@ -278,6 +278,22 @@ def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - 
     return lines
 
 
+def _fatigue_summary(outcome: RunOutcome) -> list[str]:
+    """Rainflow and Miner damage of the stress sensors with an S-N curve (none: no lines)."""
+    if not outcome.fatigue:
+        return []
+    width = max(len("name"), *(len(n) for n in outcome.fatigue))
+    curve_width = max(len("S-N curve"), *(len(r.curve.name) for r in outcome.fatigue.values()))
+    lines = ["Fatigue: rainflow count of the logged samples, Miner damage; per year: the run's traffic all year",
+             f"  {'name':<{width}}  {'S-N curve':<{curve_width}}{'cycles':>10}{'damage':>12}{'per year':>12}"
+             f"{'eq. range':>11}{'max range':>11}  unit"]
+    for name, r in outcome.fatigue.items():
+        per_year = r.damage_per_year if r.damage_per_year is not None else float("nan")
+        lines.append(f"  {name:<{width}}  {r.curve.name:<{curve_width}}{r.cycles:10.4g}{r.damage:12.4g}"
+                     f"{per_year:12.4g}{r.equivalent_stress_range * 1e-6:11.4g}{r.max_stress_range * 1e-6:11.4g}  MPa")
+    return lines
+
+
 def _vehicle_summary(outcome: RunOutcome, limit: int = 12) -> list[str]:
     result = outcome.result
     scripted = [v.id for v in outcome.scenario.vehicles]
@@ -378,6 +394,7 @@ def _print_outcome(scenario: Scenario, outcome: RunOutcome) -> None:
     """The end-of-run summary: sensor peaks, vehicles, counters, the log written."""
     print()
     print_lines(_sensor_summary(scenario, outcome.result))
+    print_lines(_fatigue_summary(outcome))
     print_lines(_vehicle_summary(outcome))
     print_lines(_run_lines(outcome))
     print(_log_done_line(outcome))

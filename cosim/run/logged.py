@@ -17,13 +17,14 @@ import platform
 import secrets
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cosim import __version__
+from cosim.analysis.fatigue import FatigueResult
 from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
 from cosim.core.limits import MAX_STEPS
@@ -37,6 +38,7 @@ from cosim.log.schemas import (
 )
 from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 
+from .engineering import FatigueRecorder, fatigue_payload, stress_curves
 from .inputs import input_files
 from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
@@ -44,6 +46,8 @@ from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
 from .simulate import SOLVER_FAILURES, build_traffic, likely_cause
 
+#: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
+FATIGUE_METADATA_NAME = "fatigue"
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
 #: How often a "running" status is logged, s of simulated time.
@@ -75,6 +79,8 @@ class RunOutcome:
         samples: sensor samples in the log (t = 0 included).
         wall_time: wall time of the whole logged run, s (time stepping and logging).
         log_bytes: size of the finished log.
+        fatigue: sensor name -> rainflow count and Miner damage of its logged samples (stress sensors with an
+            S-N curve; the damage per year for the run's traffic all year).
     """
 
     scenario: Scenario
@@ -87,6 +93,7 @@ class RunOutcome:
     samples: int
     wall_time: float
     log_bytes: int
+    fatigue: dict[str, FatigueResult] = field(default_factory=dict)
 
 
 class _DeckTimes:
@@ -301,6 +308,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
     partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
     extremes = _DeckTimes()
     samples = _Samples()
+    fatigue = FatigueRecorder(names, stress_curves(scenario))
     wall_start = time.perf_counter()
     state = {"started": False}
 
@@ -343,7 +351,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
                 traffic.frame_sink = TrafficLogger(rec)
             result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
                               sensors=sensors, road=road, output_every=every, progress=progress,
-                              observers=[extremes, samples, logger], collect=False)
+                              observers=[extremes, samples, fatigue, logger], collect=False)
             guard.closing = True  # a signal from here on must not cut the log's ending short
     except KeyboardInterrupt as exc:
         guard.closing = True
@@ -379,10 +387,14 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             with contextlib.suppress(Exception):
                 rec.close("error", f"{type(exc).__name__}: {exc}", wall_time=time.perf_counter() - wall_start)
         raise
+    damage = fatigue.results(duration, len(result.vehicle_ids))
+    if damage:
+        payload = fatigue_payload(damage)
+        rec.metadata(FATIGUE_METADATA_NAME, {k: json.dumps(jsonable(v)) for k, v in payload.items()})
     wall = time.perf_counter() - wall_start
     rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
     return RunOutcome(
         scenario=scenario, log_path=log_path, result=result, duration=duration, every=every, rate_hz=rate_hz,
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,
-        wall_time=wall, log_bytes=log_path.stat().st_size,
+        wall_time=wall, log_bytes=log_path.stat().st_size, fatigue=damage,
     )
