@@ -38,7 +38,7 @@ from .inputs import input_files
 from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import Scenario
-from .simulate import build_traffic
+from .simulate import build_traffic, plan_sumo
 
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
@@ -185,6 +185,7 @@ def run_logged(
     if bridge is None:
         bridge = scenario.build_bridge()
     live_sumo = traffic is None and scenario.traffic is not None
+    plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
     if traffic is None and not live_sumo:
         traffic = scenario.build_vehicles()
     road = scenario.build_road()
@@ -251,7 +252,7 @@ def run_logged(
             with contextlib.ExitStack() as stack, \
                     BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
                 if live_sumo:  # SUMO starts inside the log: a SUMO failure is the log's final status
-                    traffic = stack.enter_context(build_traffic(scenario, frame_sink=TrafficLogger(rec)))
+                    traffic = stack.enter_context(build_traffic(scenario, frame_sink=TrafficLogger(rec), plan=plan))
                 result = simulate(bridge, logger.paced(traffic), duration, solver=solver, sensors=sensors, road=road,
                                   output_every=every, progress=progress, observers=[extremes, samples, logger],
                                   collect=False)
