@@ -46,12 +46,14 @@ from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
 from cosim.sumo.vtypes import VehicleType, vehicle_type
 
-__all__ = ["MESSAGES_FILE", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic", "bundled_networks", "sumo_binary"]
+__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic", "bundled_networks", "sumo_binary"]
 
 #: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
 WATCH_MARGIN = 12.0
-#: SUMO's messages (its log, warnings and errors) in the scratch folder.
+#: SUMO's messages (its log, warnings and errors) in the scratch folder, and the log's attachment of them.
 MESSAGES_FILE = "sumo-messages.log"
+#: The log's attachment with the vehicle types of the run (model, mass, axles and their sources).
+VEHICLE_TYPES_ATTACHMENT = "vehicle-types.json"
 _EMPTY = np.zeros(0)
 #: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
 _BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
@@ -211,7 +213,7 @@ class SumoTraffic:
             if attach is not None:
                 import json
 
-                attach("vehicle-types.json", json.dumps([t.summary() for t in self.table()], indent=1),
+                attach(VEHICLE_TYPES_ATTACHMENT, json.dumps([t.summary() for t in self.table()], indent=1),
                        "application/json")
         except Exception:
             self.close()
