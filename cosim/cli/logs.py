@@ -8,9 +8,9 @@ import sys
 from cosim.core.traffic import vehicle_of
 from cosim.log.reader import LogOverview, iter_messages, open_log
 from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
-from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 from cosim.run.export import export_csv
 from cosim.run.figures import plot_log_sensors
+from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 
 from .text import fmt_g, print_lines, size_text
 

@@ -46,7 +46,8 @@ from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
 from cosim.sumo.vtypes import VehicleType, vehicle_type
 
-__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic", "bundled_networks", "sumo_binary"]
+__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic",
+           "bundled_networks", "sumo_binary"]
 
 #: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
 WATCH_MARGIN = 12.0
