@@ -255,7 +255,7 @@ class BridgeLocation:
 
 def _edge_or_error(net: Any, net_file: Path, edge_id: str, known: list[str]) -> Any:
     if not net.hasEdge(edge_id):
-        near = difflib.get_close_matches(edge_id, known, n=3)
+        near = difflib.get_close_matches(edge_id, known, n=3, cutoff=0.5)
         hint = f" (did you mean {', '.join(near)}?)" if near else " (`cosim bridge NET` lists candidate bridges)"
         raise ConfigError(f"the network {net_file.name} has no edge {edge_id!r}{hint}")
     edge = net.getEdge(edge_id)

@@ -155,7 +155,8 @@ def test_sumo_errors_are_reported_clearly(tmp_path):
 
 
 def test_vtype_parameters_become_quarter_cars():
-    car = model_from_parameters("car", 1500.0, "passenger", {"cosim.m_w": "150", "cosim.k_v": "76750", "cosim.c_v": "6110"})
+    car = model_from_parameters("car", 1500.0, "passenger",
+                                {"cosim.m_w": "150", "cosim.k_v": "76750", "cosim.c_v": "6110"})
     assert isinstance(car, QuarterCar) and car.m_v == 1350.0 and car.total_mass == 1500.0
     lorry = model_from_parameters("lorry", 20000.0, "truck", {})
     # A truck's library suspension at the vType's mass: the limits of a "road-friendly" suspension,
