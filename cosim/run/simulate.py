@@ -108,8 +108,6 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
                     f"no lane of {net.name} runs along the bridge axis {axis.start} -> {axis.end} ({axis_from}) "
                     "within the deck: name the bridge's edges in [traffic] edges (cosim bridge "
                     f"{config.name} lists candidates), or give axis")
-    from cosim.sumo.library import entry_for
-
     types = []
     for type_id in [v for v in demand.vtypes if v not in demand.distributions] + (
             ["DEFAULT_VEHTYPE"] if demand.untyped else []):
@@ -117,8 +115,7 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         vclass = (entry.vclass if entry is not None else None) or "passenger"
         own_length = entry.length if entry is not None else None
         try:
-            types.append(vehicle_type(type_id, vclass, own_length or entry_for(vclass)[0].length,
-                                      entry.mass if entry is not None else None,
+            types.append(vehicle_type(type_id, vclass, own_length, entry.mass if entry is not None else None,
                                       entry.params if entry is not None else {}))
         except SumoError as exc:
             where = f"{entry.file}: " if entry is not None else ""

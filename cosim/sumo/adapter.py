@@ -270,12 +270,22 @@ class SumoTraffic:
             self._scratch = None
 
     def table(self) -> list[VehicleType]:
-        """The vehicle types in use: every vType of the demand files, and SUMO's default one when used."""
+        """Every vType of the demand files (and SUMO's default one when a vehicle names no type) as the beam
+        sees it: as SUMO resolved it, or, for one SUMO has not loaded yet (route files load as the run goes),
+        as its file says."""
         demand = self.demand or Demand()
         wanted = [t for t in demand.vtypes if t not in demand.distributions]
         if demand.untyped:
             wanted.append("DEFAULT_VEHTYPE")
-        return [self.types[t] for t in wanted if t in self.types]
+        out = []
+        for type_id in wanted:
+            if type_id in self.types:
+                out.append(self.types[type_id])
+                continue
+            entry = demand.vtypes.get(type_id)
+            if entry is not None:
+                out.append(vehicle_type(type_id, entry.vclass or "passenger", entry.length, entry.mass, entry.params))
+        return out
 
     def _watch(self) -> None:
         """The deck's lanes (the named edges', or those through the deck's box); the watched lanes around them."""

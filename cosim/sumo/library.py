@@ -137,8 +137,8 @@ def _light(name: str, mass: float, mass_source: str, front: float, wheelbase: fl
         suspension=GOLDEN_CAR, length=length)
 
 
-CAR = _light("car", 1500.0, "a mid-size car with its driver (cosim's choice)", 0.9, 2.7, (0.55, 0.45), 4.5)
-VAN = _light("van", 3500.0, "the N1 limit, Regulation (EU) 2018/858", 1.0, 3.5, (0.45, 0.55), 6.0)
+CAR = _light("car", 1500.0, "a mid-size car with its driver (cosim's choice)", 0.9, 2.7, (0.55, 0.45), 5.0)
+VAN = _light("van", 3500.0, "the N1 limit, Regulation (EU) 2018/858", 1.0, 3.5, (0.45, 0.55), 6.5)
 MOTORCYCLE = _light("motorcycle", 250.0, "motorcycle and rider (cosim's choice)", 0.35, 1.5, (0.45, 0.55), 2.2)
 MOPED = _light("moped", 150.0, "moped and rider (cosim's choice)", 0.3, 1.3, (0.45, 0.55), 2.1)
 BICYCLE = _light("bicycle", 90.0, "bicycle and rider (cosim's choice)", 0.25, 1.1, (0.4, 0.6), 1.6)

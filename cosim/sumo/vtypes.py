@@ -213,11 +213,14 @@ class VehicleType:
         return text + (f"; {self.note}" if self.note else "")
 
 
-def vehicle_type(type_id: str, vclass: str, length: float, mass: float | None, params: dict[str, str]) -> VehicleType:
+def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | None,
+                 params: dict[str, str]) -> VehicleType:
     """The :class:`VehicleType` of a vType (the rules: this module's docstring).
 
     Args:
-        type_id: the vType id; vclass: its vClass; length: its length, m.
+        type_id: the vType id; vclass: its vClass; length: its length, m, or None when not known yet
+            (a vType without ``length`` before SUMO runs: the library vehicle's length stands in, and
+            ``cosim.axles`` are checked against the vehicle's length once SUMO gives it).
         mass: the vType's own ``mass`` attribute, kg, or None when it sets none
             (SUMO's default for the vClass is then never used).
         params: its ``param`` entries (only ``cosim.*`` ones are read).
@@ -226,11 +229,13 @@ def vehicle_type(type_id: str, vclass: str, length: float, mass: float | None, p
         SumoError: an unknown ``cosim.*`` param, a param that is not a number, or values that are not physical.
     """
     check_parameter_names(type_id, params)
-    if not (isinstance(length, (int, float)) and math.isfinite(length) and length > 0):
+    if length is not None and not (isinstance(length, (int, float)) and math.isfinite(length) and length > 0):
         raise SumoError(f"vType {type_id}: `length` must be > 0 m (got {length})")
     if mass is not None and not (math.isfinite(mass) and mass > 0):
         raise SumoError(f"vType {type_id}: `mass` must be > 0 kg (got {mass:g})")
     entry, note = entry_for(vclass)
+    known = length is not None
+    length = float(length) if length is not None else entry.length
     default = f"{SOURCE_DEFAULT}: {entry.name}"
     gross = entry.mass if mass is None else float(mass)
     sources = {"mass": default if mass is None else SOURCE_MASS}
@@ -251,7 +256,7 @@ def vehicle_type(type_id: str, vclass: str, length: float, mass: float | None, p
         sources["suspension"] = f"{SOURCE_DEFAULT}: {entry.suspension.name}"
         details["suspension"] = entry.suspension.source
     if (PARAM_PREFIX + "axles") in params or (PARAM_PREFIX + "axle_loads") in params:
-        axles = axles_from_parameters(type_id, length, params)
+        axles = axles_from_parameters(type_id, length if known else math.inf, params)
         sources["axles"] = SOURCE_PARAMS
         details["axles"] = f"{PARAM_PREFIX}axles, {PARAM_PREFIX}axle_loads"
     elif own:
