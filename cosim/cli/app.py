@@ -13,6 +13,7 @@ Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
     cosim validate [--out DIR] [--quick]
     cosim study STUDY.toml [--workers N] ...
     cosim dataset SPEC.toml [--out FOLDER] [--force]
+    cosim bridge NET_OR_SUMOCFG [--edge ID ...] [--near X Y] [--plot FIG.png]
 
 The work is done by :mod:`cosim.run` (and :mod:`cosim.study`,
 :mod:`cosim.validation`); the command line parses, checks and prints, and is
@@ -41,6 +42,7 @@ from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
 from .dataset import cmd_dataset
+from .bridge import DEFAULT_COUNT, cmd_bridge
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
@@ -427,6 +429,42 @@ def build_parser() -> argparse.ArgumentParser:
     dataset.add_argument("--force", action="store_true", help="overwrite an existing dataset and its logs")
     dataset.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
     dataset.set_defaults(func=cmd_dataset)
+    bridge = commands.add_parser(
+        "bridge",
+        help="find a bridge in a SUMO network: candidates, or one bridge's axis, lanes and scenario lines",
+        description=textwrap.dedent(
+            """\
+            Without --edge: list candidate bridges of a SUMO network (or of the network a
+            .sumocfg names): two-way edge pairs between two junctions and one-way edges,
+            with length, lanes, street names and the OSM bridge attribute where the network
+            kept them; edges marked as OSM bridges first, then the nearest to --near X Y
+            (network coordinates), else the longest.
+
+            With --edge (repeat it for each edge the deck carries): the bridge's axis (the
+            carriageway's centre line, x = 0 where the named lanes begin, +x the first edge's
+            direction of travel), length, lanes and their lateral positions, the junctions at
+            its ends, and the [bridge]/[traffic] lines to paste into a scenario; --plot draws
+            the network around it with the deck outline, the axis and the lanes."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim bridge city.sumocfg --near 720 230
+              cosim bridge city.sumocfg --edge 39 --edge 40
+              cosim bridge city.net.xml.gz --edge 113 --edge "43[1]" --plot bridge.png
+            """
+        ),
+        formatter_class=formatter,
+    )
+    bridge.add_argument("network", metavar="NET_OR_SUMOCFG", help="a SUMO network (.net.xml[.gz]) or config (.sumocfg)")
+    bridge.add_argument("--edge", action="append", metavar="ID", help="an edge the deck carries (repeat for more)")
+    bridge.add_argument("--near", nargs=2, type=float, metavar=("X", "Y"),
+                        help="list the candidates nearest to this point (network coordinates, m) first")
+    bridge.add_argument("--count", "-n", type=positive_int, metavar="N",
+                        help=f"candidates to list (default: {DEFAULT_COUNT})")
+    bridge.add_argument("--plot", metavar="FIG.png", help="draw the network around the bridge (needs --edge)")
+    bridge.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
+    bridge.set_defaults(func=cmd_bridge)
     return parser
 
 

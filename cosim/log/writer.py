@@ -305,6 +305,7 @@ class BlockLogger:
         self._next_status = status_every
         self._on: dict[str, bool] = {}
         self._lifted: dict[str, bool] = {}
+        self._last_x: dict[str, float] = {}  # vehicles on the deck at the end of the last block: their x
         self._model_names: dict[str, str] = {}
         self._sensor_template = (b'{"t":%s' + b"".join(b"," + _template_part(n) + b":%s" for n in self.names) + b"}")
         self._vehicle_templates: dict[tuple[str, ...], bytes] = {}
@@ -403,11 +404,13 @@ class BlockLogger:
             self._next_status += self.status_every
 
     def _gone(self, times, report) -> None:
-        """Vehicles on the deck at the end of the last block that the traffic no longer has: they left."""
+        """Vehicles on the deck at the end of the last block that the traffic no longer has: they left
+        (arrived or removed on the deck); the event carries where they were last."""
         present = set(report.ids)
         for vid in [v for v, on in self._on.items() if on and v not in present]:
             t = float(times[0])
-            self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left"})
+            self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left",
+                                             "x": self._last_x.pop(vid, 0.0)})
             self._on[vid] = self._lifted[vid] = False
 
     def _events(self, times, report) -> None:
@@ -421,10 +424,18 @@ class BlockLogger:
             changed = np.diff(np.vstack([prev[None, :], state]).astype(np.int8), axis=0) != 0
             for k, j in zip(*np.nonzero(changed)):
                 t = float(times[k])
+                if state[k, j] or names[0] != "left":
+                    x = float(report.x[k, j])
+                else:  # left: where it was last on the deck (a vehicle that vanished has no position after)
+                    x = float(report.x[k - 1, j]) if k > 0 else self._last_x.get(ids[j], float(report.x[k, j]))
                 self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": names[int(state[k, j])],
-                                                 "x": float(report.x[k, j])})
+                                                 "x": x})
         for j, vid in enumerate(ids):
             self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
+            if on[-1, j]:
+                self._last_x[vid] = float(report.x[-1, j])
+            else:
+                self._last_x.pop(vid, None)
 
     def _vehicle_item(self, vid: str) -> bytes:
         """``{"id":..,"model":..,"x":%s,...}``: one vehicle's item, its fields in :data:`VEHICLE_FIELDS` order."""
@@ -489,6 +500,10 @@ class TrafficLogger:
     def __init__(self, recorder: LogRecorder) -> None:
         self.rec = recorder
         self._types: set[str] = set()
+
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""
+        self.rec.attach(name, data, media_type)
 
     def __call__(self, frame, models: dict) -> None:
         for typ in frame.types:

@@ -44,7 +44,7 @@ from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
-from .simulate import SOLVER_FAILURES, build_traffic, likely_cause
+from .simulate import SOLVER_FAILURES, build_traffic, likely_cause, plan_sumo
 
 #: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
 FATIGUE_METADATA_NAME = "fatigue"
@@ -235,6 +235,7 @@ def run_logged(
     if bridge is None:
         bridge = scenario.build_bridge()
     live_sumo = traffic is None and scenario.traffic is not None
+    plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
     if traffic is None and not live_sumo:
         traffic = scenario.build_vehicles()
     road = scenario.build_road()
@@ -291,7 +292,7 @@ def run_logged(
     with stop_signals() as guard, contextlib.ExitStack() as sumo:
         try:
             if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
-                traffic = sumo.enter_context(build_traffic(scenario))
+                traffic = sumo.enter_context(build_traffic(scenario, plan=plan))
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
@@ -330,6 +331,13 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         with contextlib.suppress(OSError):
             partial.unlink()
 
+    def sumo_said() -> None:
+        # SUMO is closed before the log is finished, so that all it said goes into the log (the adapter
+        # attaches its messages through its frame sink when it closes).
+        if live_sumo and rec is not None:
+            with contextlib.suppress(Exception):
+                traffic.close()
+
     try:
         try:
             rec = LogRecorder(partial, names, force=False)
@@ -349,6 +357,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         with BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
             if live_sumo:
                 traffic.frame_sink = TrafficLogger(rec)
+                traffic.log_documents(rec.attach)
             result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
                               sensors=sensors, road=road, output_every=every, progress=progress,
                               observers=[extremes, samples, fatigue, logger], collect=False)
@@ -359,6 +368,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         if not state["started"] or rec is None:
             discard()
             raise RunInterrupted(signum, name, None) from None
+        sumo_said()
         rec.close("interrupted", interruption_message(exc), wall_time=time.perf_counter() - wall_start)
         raise RunInterrupted(signum, name, log_path) from None
     except (CosimError, *SOLVER_FAILURES) as exc:
@@ -374,6 +384,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             text = str(exc) if isinstance(exc, ModelError) else \
                 f"the solution diverged: the solver met non-finite values ({type(exc).__name__}: {exc})"
             message = f"{text}; likely cause: {likely_cause(scenario, road, solver)}"
+        sumo_said()
         try:
             rec.close("error", message, wall_time=time.perf_counter() - wall_start)
         except (OSError, ValueError, LogError):
@@ -391,6 +402,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
     if damage:
         payload = fatigue_payload(damage)
         rec.metadata(FATIGUE_METADATA_NAME, {k: json.dumps(jsonable(v)) for k, v in payload.items()})
+    sumo_said()
     wall = time.perf_counter() - wall_start
     rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
     return RunOutcome(
