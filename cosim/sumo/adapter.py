@@ -417,6 +417,10 @@ class SumoTraffic:
         keep = (y >= self.deck_y[0]) & (y <= self.deck_y[1]) & (x >= -self.reach) & (x <= self.axis.length
                                                                                      + self.reach)
         spd, acc = num[:, 3], num[:, 4]
+        if not keep.all() and len(keep) != len(rows):  # a vehicle's axles stay together (one body, several axles)
+            whole = np.zeros(len(rows), dtype=bool)
+            np.logical_or.at(whole, owner, keep)
+            keep = whole[owner]
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]

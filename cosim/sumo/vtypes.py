@@ -1,9 +1,12 @@
 """What a SUMO vType is for the beam: its vehicle model, its axles, and where each number came from.
 
 A vType may set SUMO's own ``mass`` (kg, the gross weight) and ``param``
-entries prefixed ``cosim.``: the quarter-car (``cosim.model``, ``cosim.m_w``,
-``cosim.k_v``, ``cosim.c_v``, ``cosim.k_t``, ``cosim.c_t``) and the axles
-(``cosim.axles``, ``cosim.axle_loads``). The rules:
+entries prefixed ``cosim.``: the suspension (``cosim.model``, ``cosim.m_w``,
+``cosim.k_v``, ``cosim.c_v``, ``cosim.k_t``, ``cosim.c_t``), the axles
+(``cosim.axles``, ``cosim.axle_loads``), the tyre contact (``cosim.contact``:
+``bilateral`` or ``unilateral``, tyre models only) and, for
+``cosim.model = half-car``, the body (``cosim.pitch``: true/false,
+``cosim.i_b``: pitch inertia, kg m^2). The rules:
 
 - **neither** ``mass`` nor ``cosim.*``: cosim's library vehicle of its vClass
   (:mod:`cosim.sumo.library`): gross mass, axles and a tyre quarter-car per
@@ -14,7 +17,13 @@ entries prefixed ``cosim.``: the quarter-car (``cosim.model``, ``cosim.m_w``,
   the vClass at the vType's mass (``mass``, else the library's); without
   ``cosim.axles``, one quarter-car at mid-length (as the params describe one);
 - ``cosim.axles`` with ``cosim.axle_loads``: those axles, each carrying its
-  share of the masses, springs and dampers.
+  share of the masses, springs and dampers;
+- ``cosim.model = half-car``: one body on all the axles (the library's axles
+  unless ``cosim.axles`` are given): per axle its share of the wheel mass,
+  suspension and tyre; the body's centre of gravity where the axle loads put
+  it (sum of share x distance, so a two-axle body carries exactly the shares),
+  pitch inertia ``cosim.i_b`` or that of a uniform body as long as the vehicle
+  (m_b L^2 / 12).
 
 A ``cosim.*`` param that is not one of these is an error that names the
 closest known one. Plain functions of values (the demand files' or
@@ -26,7 +35,7 @@ import difflib
 import math
 from dataclasses import asdict, dataclass, replace
 
-from cosim.core.vehicles import MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.library import LibraryVehicle, Suspension, entry_for
 
@@ -40,6 +49,7 @@ __all__ = [
     "VehicleType",
     "axles_from_parameters",
     "check_parameter_names",
+    "half_car_model",
     "model_from_parameters",
     "scaled_model",
     "vehicle_type",
@@ -47,10 +57,11 @@ __all__ = [
 
 PARAM_PREFIX = "cosim."
 #: The vType params cosim reads (without the prefix).
-PARAM_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads")
-#: The params that describe the quarter-car itself (not the axles).
-SUSPENSION_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t")
-MODEL_KINDS = ("quarter-car", "tyre-quarter-car", "moving-force")
+PARAM_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact", "pitch", "i_b")
+#: The params that describe the suspension itself (not the axles).
+SUSPENSION_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "contact", "pitch", "i_b")
+MODEL_KINDS = ("quarter-car", "tyre-quarter-car", "half-car", "moving-force")
+CONTACT_KINDS = ("bilateral", "unilateral")
 #: SUMO vehicle classes that count as trucks (a study's ``truck_share``).
 HEAVY_VCLASSES = ("bus", "coach", "truck", "trailer")
 #: Where a number came from, as summaries and logs say it.
@@ -84,7 +95,8 @@ def check_parameter_names(type_id: str, params: dict[str, str]) -> None:
 #: The ``cosim.*`` params each vehicle model uses (any other is an error: it would be ignored).
 MODEL_PARAMS: dict[str, tuple[str, ...]] = {
     "quarter-car": ("model", "m_w", "k_v", "c_v", "axles", "axle_loads"),
-    "tyre-quarter-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads"),
+    "tyre-quarter-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact"),
+    "half-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact", "pitch", "i_b"),
     "moving-force": ("model", "axles", "axle_loads"),
 }
 
@@ -100,6 +112,54 @@ def _number(type_id: str, params: dict[str, str], key: str) -> float | None:
     if not math.isfinite(value):
         raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}{key}` must be a finite number (got {text!r})")
     return value
+
+
+def _contact(type_id: str, params: dict[str, str]) -> bool:
+    """``cosim.contact``: True for a tyre that may leave the deck."""
+    text = params.get(PARAM_PREFIX + "contact", "bilateral").strip()
+    if text not in CONTACT_KINDS:
+        raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}contact` must be bilateral or unilateral "
+                        f"(got {text!r})")
+    return text == "unilateral"
+
+
+def _flag(type_id: str, params: dict[str, str], key: str, default: bool) -> bool:
+    text = params.get(PARAM_PREFIX + key)
+    if text is None:
+        return default
+    value = text.strip().lower()
+    if value not in ("true", "false", "1", "0"):
+        raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}{key}` must be true or false (got {text!r})")
+    return value in ("true", "1")
+
+
+def half_car_model(type_id: str, quarter: TyreQuarterCar, axles: tuple[tuple[float, float], ...], length: float,
+                   params: dict[str, str]) -> HalfCar:
+    """One body on the vType's axles: per axle its share of ``quarter`` (the whole vehicle's suspension).
+
+    Args:
+        quarter: the whole vehicle as one tyre quarter-car (masses kg, springs N/m, dampers N s/m).
+        axles: (distance behind the front bumper m, share of the load) per axle.
+        length: the vehicle's length, m (the default pitch inertia: a uniform body as long as the vehicle).
+        params: the vType's params (``cosim.pitch``, ``cosim.i_b``, ``cosim.contact``).
+
+    Raises:
+        SumoError: a param is not valid, or the body is not physical (a pitching body on one axle).
+    """
+    front = axles[0][0]
+    pitch = _flag(type_id, params, "pitch", len(axles) > 1)
+    i_b = _number(type_id, params, "i_b")
+    m_b = quarter.m_v
+    try:
+        return HalfCar(
+            m_b=m_b, i_b=m_b * length**2 / 12.0 if i_b is None else i_b,
+            cg=sum(share * (d - front) for d, share in axles),  # the axle loads' resultant: the shares hold
+            axles=tuple(Axle(distance=d - front, m_w=share * quarter.m_w, k_s=share * quarter.k_v,
+                             c_s=share * quarter.c_v, k_t=share * quarter.k_t, c_t=share * quarter.c_t)
+                        for d, share in axles),
+            pitch=pitch, unilateral=_contact(type_id, params))
+    except ConfigError as exc:
+        raise SumoError(f"vType {type_id}: {exc}") from None
 
 
 def _library_model(suspension: Suspension, mass: float) -> TyreQuarterCar:
@@ -130,11 +190,13 @@ def _param_model(type_id: str, mass: float, suspension: Suspension, params: dict
         return ratio * m_v if value is None else value
 
     k_v, c_v = given("k_v", suspension.k_v), given("c_v", suspension.c_v)
+    unilateral = _contact(type_id, params)
     try:
         if kind == "quarter-car":
             return QuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v)
+        # a half-car is first the whole vehicle on one tyre; vehicle_type shares it among the axles
         return TyreQuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v, k_t=given("k_t", suspension.k_t),
-                              c_t=given("c_t", suspension.c_t))
+                              c_t=given("c_t", suspension.c_t), unilateral=unilateral)
     except ConfigError as exc:
         raise SumoError(f"vType {type_id}: {exc}") from None
 
@@ -208,9 +270,15 @@ class VehicleType:
         return float(self.model.total_mass)
 
     def axle_models(self) -> list[tuple[str, VehicleModel]]:
-        """(model table key, model) per axle: the type itself for one axle, ``type#k`` for axle k of several."""
+        """(model table key, model) per axle: the type itself for one axle, ``type#k`` for axle k of several.
+
+        Independent axles each get their share of the model; the axles of one body (a half-car) all
+        name the whole model, which the beam step recognises as one vehicle on several contacts.
+        """
         if len(self.axles) == 1:
             return [(self.id, self.model)]
+        if getattr(self.model, "contacts", 1) > 1:
+            return [(f"{self.id}#{k}", self.model) for k in range(len(self.axles))]
         return [(f"{self.id}#{k}", scaled_model(self.model, share)) for k, (_, share) in enumerate(self.axles)]
 
     def summary(self) -> dict:
@@ -261,7 +329,7 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
     if own:
         model = _param_model(type_id, gross, entry.suspension, params)
         missing = [k for k in ("m_w", "k_v", "c_v") if k not in own]
-        if model.kind == "tyre-quarter-car":
+        if model.kind == "tyre-quarter-car":  # (a half-car too, until its axles are known)
             missing += [k for k in ("k_t", "c_t") if k not in own]
         if model.kind == "moving-force":
             missing = []
@@ -276,7 +344,7 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
         axles = axles_from_parameters(type_id, length if known else math.inf, params)
         sources["axles"] = SOURCE_PARAMS
         details["axles"] = f"{PARAM_PREFIX}axles, {PARAM_PREFIX}axle_loads"
-    elif own:
+    elif own and params.get(PARAM_PREFIX + "model", "").strip() != "half-car":
         axles = ((0.5 * length, 1.0),)
         sources["axles"] = SOURCE_PARAMS
         details["axles"] = f"one quarter-car at mid-length (no {PARAM_PREFIX}axles)"
@@ -284,6 +352,9 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
         axles, scaled = _library_axles(entry, length)
         sources["axles"] = default
         details["axles"] = entry.axles_source + (f"; scaled to the vType's {length:g} m" if scaled else "")
+    if own and params.get(PARAM_PREFIX + "model", "").strip() == "half-car":
+        assert isinstance(model, TyreQuarterCar)
+        model = half_car_model(type_id, model, axles, length, params)
     return VehicleType(id=type_id, vclass=vclass, length=float(length), model=model, axles=axles,
                        sources=sources, details=details, library=entry.name, note=note)
 
