@@ -13,11 +13,11 @@ from cosim.run.outputs import atomic_write, check_new_file, check_not_input
 def cmd_layout(args: argparse.Namespace) -> int:
     """Write the layout of a log's run (made from what the log records, as the run attached it)."""
     log, out = Path(args.log), Path(args.output)
+    check_not_input(out, "layout", [("the log", log)])
     if out.suffix.lower() != ".json":
         raise CosimError(f"{out}: a Foxglove layout is a JSON file: expected a name ending in .json")
     overview = open_log(log)
     inputs = inputs_from_log(overview)
-    check_not_input(out, "layout", [("the log", log)])
     check_new_file(out, "layout", args.force)
     with atomic_write(out, "layout") as partial:
         partial.write_bytes(layout_bytes(make_layout(inputs)))

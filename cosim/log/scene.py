@@ -42,7 +42,8 @@ from cosim.core.traffic import vehicle_of
 
 from .schemas import SCENE_FRAME, TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM, WORLD_FRAME
 
-__all__ = ["SCENE_MAX_DURATION", "SCENE_RATE_HZ", "ScenePlan", "SceneWriter", "plan_scene", "scene_sensors"]
+__all__ = ["SCENE_MAX_DURATION", "SCENE_RATE_HZ", "ScenePlan", "SceneWriter", "plan_scene", "scene_sensors",
+           "scene_wanted"]
 
 #: Scenes per second of simulated time (at most one per step).
 SCENE_RATE_HZ = 10.0
@@ -67,8 +68,8 @@ ARROW_LENGTH = 2.5
 APPROACH = 12.0
 #: Above this gross mass a vehicle is drawn as a truck, kg.
 HEAVY_KG = 3500.0
-#: Wheel paths seen in the traffic are rounded to this, m; at most this many are drawn.
-PATH_ROUNDING = 0.25
+#: Wheel paths closer than about this are drawn as one, m; at most MAX_PATHS are drawn.
+PATH_ROUNDING = 0.1
 MAX_PATHS = 24
 #: Coordinates are written to the centimetre of the drawing (a tenth of a millimetre of the deck's displacement
 #: at an exaggeration of 100): the scene is a picture, and its numbers are most of the log's extra bytes.
@@ -156,6 +157,14 @@ class ScenePlan:
                 "scene_newton_per_m": repr(self.newton_per_m), "scene_length": repr(self.length)}
 
 
+def scene_wanted(setting: bool | float | None, duration: float) -> bool:
+    """Whether a run draws its scene: ``[output].scene`` (true, false or an exaggeration), unset: on for
+    runs of at most :data:`SCENE_MAX_DURATION`."""
+    if setting is None:
+        return duration <= SCENE_MAX_DURATION
+    return setting is not False
+
+
 def _stations(bridge: BridgeModel) -> list[float]:
     """A few stations per span, equally spaced between its supports (at most one per element)."""
     xs: list[float] = []
@@ -226,11 +235,13 @@ def plan_scene(bridge: BridgeModel, sensors: Sequence[Sensor], dt: float, *, exa
     every = max(1, int(round(1.0 / (SCENE_RATE_HZ * dt))))
     marks = tuple(SceneSensor(s.name, float(s.x), float(s.y) if s.quantity != "bending_moment" else 0.0,
                               s.quantity) for s in sensors)
-    known = tuple(sorted({round(float(p) / PATH_ROUNDING) * PATH_ROUNDING for p in paths}))[:MAX_PATHS]
+    known: dict[int, float] = {}
+    for p in paths:
+        known.setdefault(round(float(p) / PATH_ROUNDING), float(p))
     return ScenePlan(length=float(bridge.length), supports=tuple(float(x) for x in bridge.support_x),
                      deck_y=(y_min, y_max), stations=tuple(stations), rows=tuple(rows),
                      exaggeration=float(exaggeration), newton_per_m=float(newton_per_m), every=every, dt=float(dt),
-                     sensors=marks, paths=known, hidden=tuple(hidden))
+                     sensors=marks, paths=tuple(sorted(known.values()))[:MAX_PATHS], hidden=tuple(hidden))
 
 
 def scene_sensors(plan: ScenePlan) -> list[Sensor]:
@@ -408,14 +419,21 @@ class SceneWriter:
             self._write(times[picked].tolist(), report.sensors[picked], report, picked.tolist())
 
     def _learn_paths(self, report: Any) -> None:
-        """Wheel paths seen in the traffic (SUMO puts vehicles where it likes): a line for each, once seen."""
+        """Wheel paths seen in the traffic (SUMO puts vehicles where it likes): a line for each, once seen
+        (paths closer than :data:`PATH_ROUNDING` are one)."""
         if report is None or not report.ids or len(self.paths) >= MAX_PATHS:
             return
-        seen = {round(float(y) / PATH_ROUNDING) * PATH_ROUNDING + 0.0 for y in np.asarray(report.y)}
         y_min, y_max = self.plan.deck_y
-        new = sorted(p for p in seen - set(self.paths) if y_min <= p <= y_max)
+        known = {round(p / PATH_ROUNDING) for p in self.paths}
+        new = False
+        for y in np.asarray(report.y, dtype=float).tolist():
+            key = round(y / PATH_ROUNDING)
+            if key not in known and y_min <= y <= y_max and len(self.paths) < MAX_PATHS:
+                known.add(key)
+                self.paths.append(y)
+                new = True
         if new:
-            self.paths = sorted(self.paths + new)[:MAX_PATHS]
+            self.paths.sort()
             self._paths_template = self._path_template()
 
     def _write(self, times: list[float], sensors: np.ndarray, report: Any, rows: list[int]) -> None:

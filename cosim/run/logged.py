@@ -32,7 +32,7 @@ from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
-from cosim.log.scene import SCENE_MAX_DURATION, ScenePlan, SceneWriter, plan_scene
+from cosim.log.scene import ScenePlan, SceneWriter, plan_scene, scene_sensors, scene_wanted
 from cosim.log.schemas import (
     LAYOUT_ATTACHMENT,
     METADATA_NAME,
@@ -170,7 +170,7 @@ def _scene_plan(scenario: Scenario, bridge: BridgeModel, sensors: list, solver: 
                 traffic: Any) -> ScenePlan | None:
     """The run's 3D scene (``[output].scene``; unset: on for runs of at most an hour), or None."""
     setting = scenario.output.scene
-    if setting is False or (setting is None and duration > SCENE_MAX_DURATION):
+    if not scene_wanted(setting, duration):
         return None
     exaggeration = None if setting is None or isinstance(setting, bool) else float(setting)
     weight = contact = None
@@ -392,7 +392,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             if live_sumo:
                 traffic.frame_sink = TrafficLogger(rec)
             result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
-                              sensors=[*sensors, *(plan.hidden if plan is not None else ())], road=road,
+                              sensors=[*sensors, *(scene_sensors(plan) if plan is not None else [])], road=road,
                               output_every=every, progress=progress, observers=[extremes, samples, logger],
                               collect=False)
             guard.closing = True  # a signal from here on must not cut the log's ending short
