@@ -106,13 +106,14 @@ def _scene_panel(length: float) -> dict[str, Any]:
     extent = max(length, 10.0) + 24.0  # the approaches drawn around the deck
     grid = 10.0 * math.ceil(1.6 * extent / 10.0)
     return {
-        "cameraState": {"distance": round(0.7 * extent, 1), "perspective": True, "phi": 72.0, "thetaOffset": 10.0,
+        "cameraState": {"distance": round(0.68 * extent, 1), "perspective": True, "phi": 66.0, "thetaOffset": 15.0,
                         "target": [0, 0, 0], "targetOffset": [0, 0, 0], "targetOrientation": [0, 0, 0, 1],
                         "fovy": 45, "near": 0.5, "far": 5000},
         "followMode": "follow-pose",
         "followTf": WORLD_FRAME,
-        "scene": {"enableStats": False, "transforms": {"showLabel": False, "axisScale": 2.0}},
-        "transforms": {},
+        # The bridge frame's axes at the first support (x along the bridge, y left, z up); no frame links.
+        "scene": {"enableStats": False, "transforms": {"showLabel": False, "axisScale": 2.0, "lineWidth": 0}},
+        "transforms": {f"frame:{WORLD_FRAME}": {"visible": False}},
         "topics": {TOPIC_SCENE: {"visible": True}, TOPIC_SCENE_STATIC: {"visible": True}},
         "layers": {"grid": {"visible": True, "frameLocked": True, "label": "Grid", "instanceId": "grid",
                             "layerId": "foxglove.Grid", "frameId": WORLD_FRAME, "size": grid,
