@@ -371,14 +371,18 @@ class SolverConfig(ConfigModel):
         )
 
 
+#: The largest exaggeration of the 3D scene: a millimetre drawn as a kilometre.
+MAX_SCENE_EXAGGERATION = 1e6
+
+
 def _scene(value: Any) -> bool | float:
     """``scene = true | false | <exaggeration>``: the 3D scene on or off, or on with this exaggeration."""
     if isinstance(value, bool):
         return value
-    if isinstance(value, (int, float)) and math.isfinite(value) and value > 0:
+    if isinstance(value, (int, float)) and math.isfinite(value) and 0 < value <= MAX_SCENE_EXAGGERATION:
         return float(value)
-    raise fail("expected true, false or the deck displacement's exaggeration in the 3D scene, a number > 0 "
-               f"(got {describe(value)})")
+    raise fail("expected true, false or the deck displacement's exaggeration in the 3D scene, a number > 0 and "
+               f"<= {MAX_SCENE_EXAGGERATION:g} (got {describe(value)})")
 
 
 class OutputConfig(ConfigModel):

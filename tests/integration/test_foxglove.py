@@ -215,6 +215,30 @@ def test_the_scene_key_of_output(tmp_path: Path) -> None:
     bad = cosim_cli("run", "bad.toml", "--out", "bad.mcap", "--quiet", cwd=tmp_path)
     assert bad.returncode == 2 and not (tmp_path / "bad.mcap").exists()
     assert bad.stderr.splitlines()[0].startswith("cosim: error: bad.toml: output.scene: expected true, false or ")
+    (tmp_path / "huge.toml").write_text(TWO_CARS + "[output]\nscene = 1e300\n")
+    huge = cosim_cli("run", "huge.toml", "--out", "huge.mcap", "--quiet", cwd=tmp_path)
+    assert huge.returncode == 2 and "output.scene" in huge.stderr and "<= 1e+06" in huge.stderr
     (tmp_path / "big.toml").write_text(TWO_CARS + "[output]\nscene = 250\n")
     assert cosim_cli("run", "big.toml", "--out", "big.mcap", "--quiet", cwd=tmp_path).returncode == 0
     assert open_log(tmp_path / "big.mcap").info["scene_exaggeration"] == "250.0"
+
+
+def test_a_layout_takes_only_names_from_a_log_and_checks_the_rest() -> None:
+    """Logs are untrusted: names are quoted into message paths, malformed metadata is one clear error."""
+    from cosim.errors import LogError
+    from cosim.log.layout import inputs_from_metadata, make_layout
+
+    inputs = inputs_from_metadata({"traffic": "scripted", "contacts": json.dumps(['a"b', "c"])},
+                                  ["x y", 'q"t'], ["displacement", "velocity"], "crafted.mcap")
+    layout = make_layout(inputs)
+    config = layout["configById"]
+    assert [p["value"] for p in config["Plot!displacement"]["paths"]] == [f'{TOPIC_SENSORS}."x y"']
+    assert [p["value"] for p in config["Plot!velocity"]["paths"]] == [f'{TOPIC_SENSORS}."q\\"t"']
+    # an id that cannot be written in a filter: every vehicle in one series instead
+    forces = [p["value"] for p in config["Plot!contact_force"]["paths"]]
+    assert forces == [f"{TOPIC_VEHICLES}.vehicles[:].contact_force"]
+    assert layout["userNodes"] == {} and layout["globalVariables"] == {}
+    for info, key in (({"scene_hz": "10.0", "scene_length": "nan"}, "scene_length"),
+                      ({"contacts": "{}"}, "contacts")):
+        with pytest.raises(LogError, match=f"^crafted.mcap: malformed cosim metadata: {key}"):
+            inputs_from_metadata(info, [], [], "crafted.mcap")
