@@ -50,8 +50,8 @@ SCENE_RATE_HZ = 10.0
 #: The scene is on by default for runs of at most this long, s.
 SCENE_MAX_DURATION = 3600.0
 #: Deck segments per span (fewer when the span has fewer elements). Each station between supports costs two
-#: sensor rows at every step (on the paper bridge with the direct basis and few vehicles about 0.4 us each,
-#: a step costing about 10 us): the deck is drawn as a spline through a few stations.
+#: sensor rows at every step (on the paper bridge with the direct basis and few vehicles about 0.6 us each,
+#: a step costing about 13 us; docs/foxglove.md): the deck is drawn as a spline through a few stations.
 SEGMENTS_PER_SPAN = 4
 #: Points drawn per segment between stations.
 DRAW_SUBDIVISIONS = 4
@@ -131,6 +131,7 @@ class ScenePlan:
         every: steps per scene; dt: the time step, s.
         sensors: the named sensors to mark.
         paths: wheel paths known before the run (scripted vehicles), m.
+        hidden: the sensors that read the deck's shape (:func:`scene_sensors`), to add after the named ones.
     """
 
     length: float
@@ -233,7 +234,8 @@ def plan_scene(bridge: BridgeModel, sensors: Sequence[Sensor], dt: float, *, exa
         exaggeration = _nice(min(max(target / sag, 1.0), 1e6), up=False) if sag > 0 and math.isfinite(sag) else 1.0
     newton_per_m = _nice((reference_contact or REFERENCE_AXLE_N) / ARROW_LENGTH, up=True)
     every = max(1, int(round(1.0 / (SCENE_RATE_HZ * dt))))
-    marks = tuple(SceneSensor(s.name, float(s.x), float(s.y) if s.quantity != "bending_moment" else 0.0,
+    axis = min(max(0.0, y_min), y_max)  # where a bending moment (of the whole section) is marked
+    marks = tuple(SceneSensor(s.name, float(s.x), float(s.y) if s.quantity != "bending_moment" else axis,
                               s.quantity) for s in sensors)
     known: dict[int, float] = {}
     for p in paths:
@@ -253,7 +255,7 @@ def scene_sensors(plan: ScenePlan) -> list[Sensor]:
 
 
 def _tokens(values: np.ndarray) -> list[bytes]:
-    """The JSON numbers of an array, flattened, rounded to the drawing's millimetre."""
+    """The JSON numbers of an array, flattened, rounded to the drawing's centimetre."""
     rounded = np.round(np.ascontiguousarray(values, dtype=np.float64), _DECIMALS) + 0.0  # no "-0.0"
     text = orjson.dumps(rounded.ravel(), option=orjson.OPT_SERIALIZE_NUMPY)
     return text[1:-1].split(b",") if len(text) > 2 else []
