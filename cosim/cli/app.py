@@ -1,6 +1,6 @@
 """The ``cosim`` command line: the parser, :func:`main` and how errors become exit statuses.
 
-Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
+Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.layout`, :mod:`.modes`,
 :mod:`.static`, :mod:`.study`, :mod:`.validate`)::
 
     cosim modes SCENARIO [--count N] [--json] [--plot FILE.png]
@@ -10,6 +10,7 @@ Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
     cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--force]
     cosim info LOG.mcap
     cosim plot LOG.mcap [--sensor NAME ...] -o FIG.png [--force]
+    cosim layout LOG.mcap -o LAYOUT.json [--force]
     cosim validate [--out DIR] [--quick]
     cosim study STUDY.toml [--workers N] ...
     cosim dataset SPEC.toml [--out FOLDER] [--force]
@@ -41,8 +42,9 @@ from cosim.run.export import EXPORT_TOPICS
 from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
-from .dataset import cmd_dataset
 from .bridge import DEFAULT_COUNT, cmd_bridge
+from .dataset import cmd_dataset
+from .layout import cmd_layout
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
@@ -105,6 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
               cosim info run1.mcap
               cosim export run1.mcap --csv run1.csv
               cosim plot run1.mcap -o run1.png
+              cosim layout run1.mcap -o run1-layout.json   # for Foxglove
               cosim replay run1.mcap --scenario other-bridge.toml
               cosim modes paper-double-tee --count 12 --plot modes.png
               cosim static paper-double-tee --load 20 3.325 -100e3
@@ -222,7 +225,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run                              # the default traffic run -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run                              # the default traffic run
+                                                     # -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
               cosim run paper-double-tee             # the paper's two quarter-cars
               cosim run my-bridge.toml --out results/run1.mcap --csv results/run1.csv
               cosim run my-bridge-no-vehicles.toml --out summary.json
@@ -344,6 +348,29 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", required=True, metavar="FIG.png", help="the figure (.png, .pdf, .svg, ...)")
     plot.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
     plot.set_defaults(func=cmd_plot)
+
+    layout = commands.add_parser(
+        "layout",
+        help="write the Foxglove layout made for a log's run",
+        description=textwrap.dedent(
+            """\
+            Write the Foxglove layout of a log's run, the one the run attached to its log
+            (foxglove_layout.json), made from what the log records: a plot per sensor
+            quantity with its sensors, the vehicles' contact forces (per vehicle for
+            scripted vehicles, all together for SUMO traffic), the positions of the traffic
+            near the deck, a table of the vehicles on the deck, the events and status, and
+            the 3D scene of the deck and its vehicles when the log has one. Logs written
+            before layouts existed get one too. Open the log in Foxglove (desktop app or
+            app.foxglove.dev: Open local file) and import the layout with Layouts ->
+            Import from file. An existing file is replaced only with --force, never the log."""
+        ),
+        epilog="examples:\n  cosim layout runs/run1.mcap -o run1-layout.json\n",
+        formatter_class=formatter,
+    )
+    layout.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    layout.add_argument("-o", "--output", required=True, metavar="LAYOUT.json", help="the layout file to write")
+    layout.add_argument("--force", "-f", action="store_true", help="overwrite LAYOUT.json if it exists")
+    layout.set_defaults(func=cmd_layout)
 
     validate = commands.add_parser(
         "validate",

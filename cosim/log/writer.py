@@ -21,8 +21,9 @@ import struct
 import threading
 import time
 import traceback
+from collections.abc import Iterable
 from pathlib import Path
-from typing import IO, Any, Iterable
+from typing import IO, Any
 
 import numpy as np
 import orjson
@@ -152,10 +153,11 @@ class LogRecorder:
         sensor_names: the sensor channels, in order.
         force: overwrite an existing file (otherwise refuse).
         chunk_size: bytes per chunk; small chunks lose little when the process is killed.
+        scene: also register the 3D scene's topics (:mod:`cosim.log.scene`).
     """
 
     def __init__(self, path: str | Path, sensor_names: Iterable[str], force: bool = False,
-                 chunk_size: int = 256 * 1024) -> None:
+                 chunk_size: int = 256 * 1024, scene: bool = False) -> None:
         self.path = Path(path)
         if self.path.exists() and not force:
             raise LogError(f"{self.path}: exists; refusing to overwrite a log (use --force)")
@@ -173,9 +175,12 @@ class LogRecorder:
         self._sequence = 0
         self._closed = False
         self.final_state: str | None = None
-        for topic, schema in topic_schemas(self.sensor_names):
-            sid = self._writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
-            self._channels[topic] = self._writer.register_channel(topic, "json", sid)
+        schema_ids: dict[bytes, int] = {}
+        for topic, schema in topic_schemas(self.sensor_names, scene=scene):
+            text = json.dumps(schema).encode()
+            if text not in schema_ids:  # one schema record for the topics that share it
+                schema_ids[text] = self._writer.register_schema(schema["title"], "jsonschema", text)
+            self._channels[topic] = self._writer.register_channel(topic, "json", schema_ids[text])
         self._last_t = 0.0
         # The block logger's thread and the traffic source (main thread) both write.
         self._lock = threading.Lock()
@@ -243,7 +248,7 @@ class LogRecorder:
                 self._writer.finish()
                 self._stream.close()
 
-    def __enter__(self) -> "LogRecorder":
+    def __enter__(self) -> LogRecorder:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -294,12 +299,17 @@ class BlockLogger:
     compiled solver computes the next block, so logging costs little wall
     time on a machine with a spare core; the queue holds a few blocks at most.
     Use as a context manager (or call :meth:`close`) so the thread drains.
+
+    The first ``len(sensor_names)`` sensor columns of a block are logged; columns after them (the
+    scene's, :mod:`cosim.log.scene`) go only to ``scene`` (an object with ``write_block(times, report)``),
+    which draws the 3D scene in the same thread.
     """
 
     def __init__(self, recorder: LogRecorder, sensor_names: Iterable[str], total_time: float,
-                 status_every: float = 10.0, threaded: bool = True) -> None:
+                 status_every: float = 10.0, threaded: bool = True, scene: Any = None) -> None:
         self.rec = recorder
         self.names = list(sensor_names)
+        self.scene = scene
         self.total_time = total_time
         self.status_every = status_every
         self._next_status = status_every
@@ -327,7 +337,7 @@ class BlockLogger:
         else:
             self._queue.put((times, keep, report))
 
-    def paced(self, traffic: Any) -> "_PacedTraffic":
+    def paced(self, traffic: Any) -> _PacedTraffic:
         """``traffic``, wrapped so that the writer thread knows when the solver starts its next block.
 
         Pass the wrapper to :func:`cosim.core.simulation.simulate` instead of
@@ -374,7 +384,7 @@ class BlockLogger:
             raise LogError(f"{self.rec.path}: writing the log failed: {self._error!r}"
                            + (f" ({where[-3].strip()})" if len(where) >= 3 else ""))
 
-    def __enter__(self) -> "BlockLogger":
+    def __enter__(self) -> BlockLogger:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -389,8 +399,8 @@ class BlockLogger:
         kept = np.flatnonzero(keep)
         if len(kept):
             t = times[kept]
-            tokens = _number_tokens(np.column_stack([t, report.sensors[kept]]))
             width = 1 + len(self.names)
+            tokens = _number_tokens(np.column_stack([t, report.sensors[kept, :width - 1]]))
             template = self._sensor_template
             rec.write_encoded(TOPIC_SENSORS, t.tolist(),
                               [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)])
@@ -398,6 +408,8 @@ class BlockLogger:
         if report.ids:
             self._events(times, report)
             self._vehicles(times, kept, report)
+        if self.scene is not None:
+            self.scene.write_block(times, report)
         if times[-1] >= self._next_status:
             rec.status(float(times[-1]), "running", progress=float(times[-1] / self.total_time))
             rec.flush()

@@ -438,17 +438,34 @@ class SolverConfig(ConfigModel):
         )
 
 
+#: The largest exaggeration of the 3D scene: a millimetre drawn as a kilometre.
+MAX_SCENE_EXAGGERATION = 1e6
+
+
+def _scene(value: Any) -> bool | float:
+    """``scene = true | false | <exaggeration>``: the 3D scene on or off, or on with this exaggeration."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)) and math.isfinite(value) and 0 < value <= MAX_SCENE_EXAGGERATION:
+        return float(value)
+    raise fail("expected true, false or the deck displacement's exaggeration in the 3D scene, a number > 0 and "
+               f"<= {MAX_SCENE_EXAGGERATION:g} (got {describe(value)})")
+
+
 class OutputConfig(ConfigModel):
-    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, and the logging rate.
+    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, the logging rate, the 3D scene.
 
     The rate is ``rate_hz`` (default :data:`DEFAULT_RATE_HZ`) or, for
-    compatibility, ``every`` (keep every N-th step); not both.
+    compatibility, ``every`` (keep every N-th step); not both. ``scene``: the
+    log's 3D scene (:mod:`cosim.log.scene`) on or off, or on with a chosen
+    exaggeration; unset, it is on for runs of at most an hour.
     """
 
     log: Annotated[str, Strict(), Field(min_length=1)] | None = None
     rate_hz: Positive | None = None
     every: PositiveInt | None = None
     csv: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    scene: Annotated[bool | float, PlainValidator(_scene)] | None = None
 
     @model_validator(mode="after")
     def _one_rate(self) -> OutputConfig:

@@ -101,7 +101,9 @@ def execute_run(task: RunTask) -> dict[str, Any]:
         write_file(folder / SCENARIO_FILE, task.scenario_text)
         scenario = load_scenario(folder / SCENARIO_FILE)
         bridge = scenario.build_bridge()
-        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge, progress=_StopCheck(stop))
+        # a study's runs are reduced to numbers: no 3D scene unless its scenario asks for one
+        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge, progress=_StopCheck(stop),
+                             scene_by_default=False)
         row.update(run_statistics(scenario, bridge, outcome, task.percentiles, task.vehicles_per_year))
         row["status"] = "ok"
         row["error"] = ""
