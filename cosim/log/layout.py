@@ -50,6 +50,10 @@ _QUANTITY_TITLES = {
     "velocity": "deck velocity",
     "acceleration": "deck acceleration",
     "bending_moment": "bending moment",
+    "stress": "normal stress",
+    "strain": "strain",
+    "shear_stress_xy": "shear stress xy",
+    "shear_stress_xz": "shear stress xz",
 }
 _PLAIN_NAME = re.compile(r"^[A-Za-z0-9_-]+$")
 

@@ -91,6 +91,10 @@ _QUANTITY_COLORS = {
     "velocity": {"r": 0.6, "g": 0.4, "b": 1.0, "a": 1.0},
     "acceleration": {"r": 1.0, "g": 0.3, "b": 0.8, "a": 1.0},
     "bending_moment": {"r": 1.0, "g": 1.0, "b": 0.3, "a": 1.0},
+    "stress": {"r": 1.0, "g": 0.55, "b": 0.1, "a": 1.0},
+    "strain": {"r": 0.3, "g": 1.0, "b": 0.5, "a": 1.0},
+    "shear_stress_xy": {"r": 1.0, "g": 0.75, "b": 0.55, "a": 1.0},
+    "shear_stress_xz": {"r": 0.85, "g": 0.55, "b": 0.35, "a": 1.0},
 }
 _IDENTITY = {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
 _S45 = math.sqrt(0.5)

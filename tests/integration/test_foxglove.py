@@ -204,6 +204,30 @@ def test_a_sumo_run_draws_its_traffic_in_the_scene(tmp_path: Path) -> None:
     assert lanes == pytest.approx([-1.875, 1.875], abs=0.01)  # the bundled network's lane centres (README)
 
 
+def test_every_sensor_quantity_gets_a_plot_and_a_place_in_the_scene(tmp_path: Path) -> None:
+    """Stresses, strains and shear stresses (section points) are plotted and drawn like deck sensors."""
+    from cosim.core.sensors import SECTION_POINT_QUANTITIES
+
+    paper = (Path(__file__).resolve().parents[2] / "cosim" / "scenarios" / "paper-double-tee.toml").read_text()
+    extra = "".join(f'[[sensors]]\nname = "{q}"\nx = 20.0\ny = 1.0\nz = -0.1\nquantity = "{q}"\n'
+                    for q in SECTION_POINT_QUANTITIES)
+    assert "duration = 20.0" in paper
+    (tmp_path / "all.toml").write_text(paper.replace("[[vehicles]]", extra + "[[vehicles]]", 1)
+                                       .replace("duration = 20.0", "duration = 0.5"))
+    result = cosim_cli("run", "all.toml", "--out", "all.mcap", "--quiet", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    layout = json.loads(open_log(tmp_path / "all.mcap").attachments[LAYOUT_ATTACHMENT])
+    messages = read_log(tmp_path / "all.mcap").messages
+    for q in SECTION_POINT_QUANTITIES:
+        series = layout["configById"][f"Plot!{q}"]["paths"]
+        assert [p["value"] for p in series] == [f"{TOPIC_SENSORS}.{q}"]
+        assert all(isinstance(v, float) for v in picked(messages, series[0]["value"]))
+    labels = {label["text"] for e in messages[TOPIC_SCENE_STATIC][0][1]["entities"] for label in e.get("texts", [])}
+    assert set(SECTION_POINT_QUANTITIES) <= labels
+    spheres = [e["spheres"] for e in messages[TOPIC_SCENE][-1][1]["entities"] if e["id"] == "sensors"][0]
+    assert len(spheres) == 4 + len(SECTION_POINT_QUANTITIES)  # the scenario's four sensors and these
+
+
 def test_the_scene_key_of_output(tmp_path: Path) -> None:
     off = TWO_CARS + "[output]\nscene = false\n"
     (tmp_path / "off.toml").write_text(off)
