@@ -282,7 +282,8 @@ def test_a_sensor_read_every_nth_step_is_the_same_numbers_at_those_steps(basis):
                                  15.0 + k, entry_time=0.3 * k) for k in range(3))
     dense, sparse = Sensor("mid", 15.0, 1.0), Sensor("mid_every_7", 15.0, 1.0, every=7)
     acc = Sensor("acc_every_7", 10.0, -1.0, "acceleration", every=7)
-    run = simulate(bridge, ScriptedTraffic(cars, 30.0), 3.0, SolverSettings(dt=2e-3, basis=basis, modes=20 if basis == "modal" else None),
+    solver = SolverSettings(dt=2e-3, basis=basis, modes=20 if basis == "modal" else None)
+    run = simulate(bridge, ScriptedTraffic(cars, 30.0), 3.0, solver,
                    [dense, sparse, acc, Sensor("acc", 10.0, -1.0, "acceleration")], block_steps=50)
     steps = np.rint(run.t / 2e-3).astype(int)
     read = steps % 7 == 0
