@@ -9,7 +9,8 @@ bumper), heading, speed, acceleration and type. A vehicle is followed by
 position, not by the edge it is on: it stays in the frames while it crosses
 the junction at a deck end, so each of its axles is on the deck from the
 moment it passes one end until it passes the other. Each vehicle becomes one
-quarter-car per axle (:mod:`cosim.sumo.vtypes`), its distance behind the
+contact point per axle (a quarter-car per axle, or one half-car body on all
+of them: :mod:`cosim.sumo.vtypes`), each at its distance behind the
 bumper along the heading, projected onto the bridge axis (x along the axis
 from its start point, y to the left of it); it loads the deck while that
 projection lies on it (:func:`cosim.core.traffic.on_deck`) within the deck's

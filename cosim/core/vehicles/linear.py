@@ -107,7 +107,10 @@ def group_coefficients(g, groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2
         e0[j] = ca * (-fleet.weight[j] + t0[k] + mt[k] * (bc[k] @ z0dd))
         for m in range(nc):
             if not groups.flying[first + m]:
-                h[k, m] = ca * ((1.0 if k == m else 0.0) - ca * mt[k] * (bc[k] @ gm[:, m]))
+                bg = 0.0  # bc[k] . gm[:, m], a strided column: a loop, not '@' (which wants contiguous arrays)
+                for i in range(gm.shape[0]):
+                    bg += bc[k, i] * gm[i, m]
+                h[k, m] = ca * ((1.0 if k == m else 0.0) - ca * mt[k] * bg)
 
 
 @compiled
