@@ -5,7 +5,7 @@ import argparse
 import json
 import sys
 
-from cosim.log.reader import LogOverview, open_log
+from cosim.log.reader import LogOverview, file_is_complete, open_log
 from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_SENSORS
 from cosim.run.export import export_csv
 from cosim.run.figures import plot_log_sensors
@@ -13,22 +13,51 @@ from cosim.run.figures import plot_log_sensors
 from .text import fmt_g, print_lines, size_text
 
 
+def window_text(start: float | None, end: float | None) -> str:
+    """`` from t = T0 to T1 s`` for a window of time given on the command line ("" for none)."""
+    if start is None and end is None:
+        return ""
+    low = f"t = {fmt_g(start, 9)}" if start is not None else "the start"
+    high = f"{fmt_g(end, 9)} s" if end is not None else "the end"
+    if start is None:
+        high = f"t = {high}"
+    return f" from {low} to {high}"
+
+
 def cmd_export(args: argparse.Namespace) -> int:
-    """Write a topic of a log as CSV."""
-    overview = open_log(args.log)
-    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force)
-    if overview.truncated:
+    """Write a topic of a log (or of a window of it) as CSV."""
+    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force, start=args.start,
+                               end=args.end)
+    if not file_is_complete(args.log):
         print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
               file=sys.stderr)
     units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
-    print(f"Wrote {rows} rows of {args.topic} to {args.csv} (columns {','.join(columns)}; {units})")
+    print(f"Wrote {rows} rows of {args.topic}{window_text(args.start, args.end)} to {args.csv} "
+          f"(columns {','.join(columns)}; {units})")
     return 0
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    """Summarise a log."""
-    print_lines(info_lines(open_log(args.log)))
+    """Summarise a log: from its summary, or (``--verify``) from every chunk."""
+    print_lines(info_lines(open_log(args.log, check="full" if args.verify else "file")))
     return 0
+
+
+def checked_line(o: LogOverview) -> str:
+    """What ``cosim info`` verified, and what it did not."""
+    if not o.complete:
+        return (f"Checked: the {o.chunks} complete chunk(s), each decompressed and its checksum verified "
+                "(a file cut short has no summary)")
+    data = {True: "the data section's checksum (every byte is as written)",
+            False: "no data-section checksum in this log (an older cosim)", None: ""}[o.data_checksum]
+    if o.check == "full":
+        parts = [f"all {o.chunks} chunks decompressed and their checksums verified", data,
+                 "the summary agrees with them" if o.summary_checked else "no summary"]
+        return "Checked: " + "; ".join(p for p in parts if p)
+    status = f"{o.chunks_read} of {o.chunks} chunks decompressed (for the final status)"
+    unread = "" if o.data_checksum else "; the other chunks were not read"
+    return (f"Checked: {data}, the summary's and the attachments' checksums; {status}{unread}; "
+            "counts from the summary (--verify reads every chunk)")
 
 
 def info_lines(o: LogOverview) -> list[str]:
@@ -79,12 +108,13 @@ def info_lines(o: LogOverview) -> list[str]:
                      "it is read up to its last complete chunk")
     atts = ", ".join(f"{name} ({size_text(len(data))})" for name, data in o.attachments.items()) or "none"
     lines.append(f"Attachments: {atts}")
+    lines.append(checked_line(o))
     return lines
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """Draw a log's sensor time histories."""
-    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force)
-    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)}) "
-          f"to {args.output}")
+    """Draw a log's sensor time histories (or a window of them)."""
+    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force, start=args.start, end=args.end)
+    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)})"
+          f"{window_text(args.start, args.end)} to {args.output}")
     return 0
