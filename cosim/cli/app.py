@@ -306,9 +306,10 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--csv", metavar="OUT.csv", required=True, help="the CSV file to write")
     export.add_argument("--topic", default=TOPIC_SENSORS, metavar="TOPIC",
                         help=f"the topic to export (one of: {topics}; default: {TOPIC_SENSORS})")
-    export.add_argument("--from", dest="start", type=finite_float, metavar="T0",
+    # float, not finite_float: a time that is not finite is then the window check's one-line error.
+    export.add_argument("--from", dest="start", type=float, metavar="T0",
                         help="export from t = T0 s of simulated time (default: the log's start)")
-    export.add_argument("--to", dest="end", type=finite_float, metavar="T1",
+    export.add_argument("--to", dest="end", type=float, metavar="T1",
                         help="export up to t = T1 s, included (default: the log's end)")
     export.add_argument("--force", "-f", action="store_true", help="overwrite OUT.csv if it exists")
     export._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
@@ -357,9 +358,9 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--sensor", action="append", metavar="NAME",
                       help="a sensor to draw (repeat for more; default: all)")
     plot.add_argument("-o", "--output", required=True, metavar="FIG.png", help="the figure (.png, .pdf, .svg, ...)")
-    plot.add_argument("--from", dest="start", type=finite_float, metavar="T0",
+    plot.add_argument("--from", dest="start", type=float, metavar="T0",
                       help="draw from t = T0 s of simulated time (default: the log's start)")
-    plot.add_argument("--to", dest="end", type=finite_float, metavar="T1",
+    plot.add_argument("--to", dest="end", type=float, metavar="T1",
                       help="draw up to t = T1 s, included (default: the log's end)")
     plot.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
     plot._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)

@@ -472,8 +472,10 @@ def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
         position = body + length
     statistics = found.get(Opcode.STATISTICS, [])
     indexes: list[ChunkIndex] = sorted(found.get(Opcode.CHUNK_INDEX, []), key=lambda c: c.chunk_start_offset)
-    if len(statistics) != 1 or statistics[0].chunk_count != len(indexes):
-        return None  # written without statistics or a chunk index
+    channels = {c.id: c for c in found.get(Opcode.CHANNEL, [])}
+    if len(statistics) != 1 or statistics[0].chunk_count != len(indexes) \
+            or any(n and cid not in channels for cid, n in statistics[0].channel_message_counts.items()):
+        return None  # written without statistics, a chunk index or the channels
     chunks = []
     for number, index in enumerate(indexes, start=1):
         if not (len(MAGIC) <= index.chunk_start_offset
@@ -488,8 +490,8 @@ def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
     for index in [*found.get(Opcode.ATTACHMENT_INDEX, []), *found.get(Opcode.METADATA_INDEX, [])]:
         if not (len(MAGIC) <= index.offset and index.offset + index.length <= data_end):
             raise _corrupt(path, f"the summary's index of {index.name!r} points outside the data section")
-    return _Summary(schemas={s.id: s for s in found.get(Opcode.SCHEMA, [])},
-                    channels={c.id: c for c in found.get(Opcode.CHANNEL, [])}, statistics=statistics[0],
+    return _Summary(schemas={s.id: s for s in found.get(Opcode.SCHEMA, [])}, channels=channels,
+                    statistics=statistics[0],
                     chunks=chunks, attachments=found.get(Opcode.ATTACHMENT_INDEX, []),
                     metadata=found.get(Opcode.METADATA_INDEX, []), data_end=data_end, data_crc=data_crc)
 
@@ -898,11 +900,9 @@ def _overview_from_summary(path: Path, fh: IO[bytes], summary: _Summary, out: Lo
         out.attachments[attachment.name] = attachment.data
     statistics = summary.statistics
     for cid, count in statistics.channel_message_counts.items():
-        if count:
-            channel = summary.channels.get(cid)
-            if channel is None:
-                raise _corrupt(path, f"the summary counts messages on channel {cid}, which it does not define")
-            out.counts[channel.topic] = out.counts.get(channel.topic, 0) + count
+        if count:  # every counted channel is defined (_read_summary)
+            topic = summary.channels[cid].topic
+            out.counts[topic] = out.counts.get(topic, 0) + count
     if statistics.message_count:
         out.start_time, out.end_time = statistics.message_start_time / 1e9, statistics.message_end_time / 1e9
     before = stats.chunks if stats is not None else 0
@@ -979,30 +979,41 @@ def _window_ns(start: float | None, end: float | None) -> tuple[int, int] | None
     for name, value in (("start", start), ("end", end)):
         if value is not None and not math.isfinite(value):
             raise CosimError(f"`{name}` of the time window: expected a finite time in s, got {value!r}")
-    lo = 0 if start is None else min(max(to_ns(start), 0), _MAX_NS)
-    hi = _MAX_NS if end is None else min(max(to_ns(end), -1), _MAX_NS)
+    lo = 0 if start is None else max(_log_time(start), 0)
+    hi = _MAX_NS if end is None else _log_time(end)
     return lo, hi
 
 
-def check_window(overview: LogOverview, start: float | None, end: float | None) -> None:
-    """Check a window of simulated time ``[start, end]`` (s; None: the log's start or end) against a log:
-    finite, not empty, and overlapping the time the log covers.
+def _log_time(t: float) -> int:
+    """A finite time in s as a log time (ns, as :func:`cosim.log.schemas.to_ns`), clamped to what log times
+    can be (and one below: nothing lies before a negative end)."""
+    ns = t * 1e9
+    if ns >= _MAX_NS:
+        return _MAX_NS
+    return to_ns(t) if ns > -1.0 else -1
+
+
+def check_window(start: float | None, end: float | None, overview: LogOverview | None = None) -> None:
+    """Check a window of simulated time ``[start, end]`` (s; None: the log's start or end): finite, not
+    empty, and, given the log's ``overview``, overlapping the time the log covers.
 
     Raises:
-        CosimError: one line naming ``--from``/``--to`` and what the log covers.
+        CosimError: one line naming ``--from``/``--to`` (and what the log covers).
     """
     for option, value in (("--from", start), ("--to", end)):
         if value is not None and not math.isfinite(value):
             raise CosimError(f"{option} {value!r}: expected a finite time in s")
     if start is not None and end is not None and not end > start:
         raise CosimError(f"--from {start:g} --to {end:g}: an empty window; --to must be later than --from")
+    if overview is None:
+        return
     path = overview.path
     if not overview.counts:
         raise CosimError(f"{path}: the log holds no messages, so no window of it can be read")
     covers = f"the log covers t = {overview.start_time:g} to {overview.end_time:g} s"
-    if start is not None and to_ns(start) > to_ns(overview.end_time):
+    if start is not None and _log_time(start) > _log_time(overview.end_time):
         raise CosimError(f"{path}: --from {start:g} s: after the end of the log ({covers})")
-    if end is not None and to_ns(end) < to_ns(overview.start_time):
+    if end is not None and _log_time(end) < _log_time(overview.start_time):
         raise CosimError(f"{path}: --to {end:g} s: before the start of the log ({covers})")
 
 

@@ -55,12 +55,13 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
             outside the log, or the CSV cannot be written.
     """
     log, out = Path(log), Path(out)
+    check_window(start, end)  # before the log is read
     overview = open_log(log, check="summary", stats=stats)
     if topic not in EXPORT_TOPICS:
         present = ", ".join(t for t in EXPORT_TOPICS if overview.counts.get(t))
         raise CosimError(f"--topic {topic}: not an exportable topic (this log has: {present})")
     if start is not None or end is not None:
-        check_window(overview, start, end)
+        check_window(start, end, overview)
     if topic == TOPIC_SENSORS:
         columns = ["t", *overview.sensor_names]
     elif topic == TOPIC_VEHICLES:

@@ -46,6 +46,7 @@ def plot_log_sensors(log: str | os.PathLike[str], out: str | os.PathLike[str], n
             log, no sample in it, an unsupported file type, or ``out`` exists (without ``force``) or cannot be
             written.
     """
+    check_window(start, end)  # before the log is read
     overview = open_log(log, check="summary", stats=stats)
     available = overview.sensor_names
     if not available:
@@ -56,7 +57,7 @@ def plot_log_sensors(log: str | os.PathLike[str], out: str | os.PathLike[str], n
         raise CosimError(f"{log}: no sensor {', '.join(unknown)} in this log (sensors: {', '.join(available)})")
     windowed = start is not None or end is not None
     if windowed:
-        check_window(overview, start, end)
+        check_window(start, end, overview)
     out = Path(out)
     if out.suffix.lower().lstrip(".") not in plots.figure_formats():
         raise CosimError(f"{out}: unsupported file type for the plot (expected .png, .pdf, .svg, ...)")
