@@ -46,18 +46,18 @@ def cmd_info(args: argparse.Namespace) -> int:
 def checked_line(o: LogOverview) -> str:
     """What ``cosim info`` verified, and what it did not."""
     if not o.complete:
-        return (f"Checked: the {o.chunks} complete chunk(s), each decompressed and its checksum verified "
-                "(a file cut short has no summary)")
-    data = {True: "the data section's checksum (every byte is as written)",
-            False: "no data-section checksum in this log (an older cosim)", None: ""}[o.data_checksum]
+        return (f"Checked: the {o.chunks} complete chunk(s) decompressed and their checksums verified "
+                "(a file cut short has no summary or file checksum)")
+    older = " (this log has no file checksum: an older cosim)" if o.data_checksum is False else ""
     if o.check == "full":
-        parts = [f"all {o.chunks} chunks decompressed and their checksums verified", data,
-                 "the summary agrees with them" if o.summary_checked else "no summary"]
-        return "Checked: " + "; ".join(p for p in parts if p)
-    status = f"{o.chunks_read} of {o.chunks} chunks decompressed (for the final status)"
-    unread = "" if o.data_checksum else "; the other chunks were not read"
-    return (f"Checked: {data}, the summary's and the attachments' checksums; {status}{unread}; "
-            "counts from the summary (--verify reads every chunk)")
+        file = "the file's (every byte as written), " if o.data_checksum else ""
+        agree = " (the summary agrees)" if o.summary_checked else ""
+        return (f"Checked: all {o.chunks} chunks decompressed and their checksums verified, and {file}the "
+                f"summary's and the attachments'{older}; counts from the messages{agree}")
+    file = "the file (every byte as written), " if o.data_checksum else ""
+    unread = "" if o.data_checksum else ", the others not read"
+    return (f"Checked: checksums of {file}the summary and the attachments; {o.chunks_read} of {o.chunks} chunks "
+            f"decompressed{unread}{older}; counts from the summary (--verify: every chunk)")
 
 
 def info_lines(o: LogOverview) -> list[str]:

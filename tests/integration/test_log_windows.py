@@ -219,13 +219,13 @@ def test_info_reads_the_summary_and_one_chunk_and_verify_reads_them_all(slow_log
     assert full.final_status["state"] == "finished" and full.counts[TOPIC_SENSORS] == 20001
     result = cosim_cli("info", str(slow_log))
     assert result.returncode == 0, result.stderr
-    assert (f"Checked: the data section's checksum (every byte is as written), the summary's and the attachments' "
-            f"checksums; 1 of {len(chunks)} chunks decompressed (for the final status); counts from the summary "
-            "(--verify reads every chunk)") in result.stdout
+    assert (f"Checked: checksums of the file (every byte as written), the summary and the attachments; 1 of "
+            f"{len(chunks)} chunks decompressed; counts from the summary (--verify: every chunk)") in result.stdout
     verified = cosim_cli("info", "--verify", str(slow_log))
     assert verified.returncode == 0, verified.stderr
-    assert (f"Checked: all {len(chunks)} chunks decompressed and their checksums verified; the data section's "
-            "checksum (every byte is as written); the summary agrees with them") in verified.stdout
+    assert (f"Checked: all {len(chunks)} chunks decompressed and their checksums verified, and the file's (every "
+            "byte as written), the summary's and the attachments'; counts from the messages (the summary agrees)"
+            ) in verified.stdout
     assert verified.stdout.replace(verified.stdout.splitlines()[-1], "") == \
         result.stdout.replace(result.stdout.splitlines()[-1], "")  # the same overview either way
 
