@@ -213,6 +213,8 @@ def test_info_reads_the_summary_and_one_chunk_and_verify_reads_them_all(slow_log
     full = open_log(slow_log, check="full", stats=full_stats)
     assert fast_stats.chunks == 1 and full_stats.chunks == len(chunks)  # the last chunk: the final status
     assert (fast.chunks_read, fast.chunks, fast.data_checksum) == (1, len(chunks), True)
+    summary = open_log(slow_log, check="summary")  # what export and plot read first: no pass over the file
+    assert (summary.chunks_read, summary.data_checksum, summary.counts) == (1, None, full.counts)
     for name in ("counts", "start_time", "end_time", "final_status", "attachments", "metadata", "sensor_names",
                  "quantities", "library"):
         assert getattr(fast, name) == getattr(full, name), name
