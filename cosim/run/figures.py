@@ -63,8 +63,8 @@ def plot_log_sensors(log: str | os.PathLike[str], out: str | os.PathLike[str], n
         raise CosimError(f"{out}: unsupported file type for the plot (expected .png, .pdf, .svg, ...)")
     check_not_input(out, "plot", [("the log", Path(log))])
     check_new_file(out, "plot", force)
-    # Envelope bins span what the log covers within the window (0 to the end for a whole cosim log).
-    t_lo = min(0.0, overview.start_time) if start is None else max(start, overview.start_time)
+    # Envelope bins span what the log covers within the window (from 0, as always, for a whole log).
+    t_lo = 0.0 if start is None else max(start, overview.start_time)
     t_hi = overview.end_time if end is None else min(end, overview.end_time)
     t, series = sensor_history(log, chosen, t_lo, t_hi, start=start, end=end, stats=stats)
     if windowed and not len(t):
