@@ -48,7 +48,7 @@ def checked_line(o: LogOverview) -> str:
     if not o.complete:
         return (f"Checked: the {o.chunks} complete chunk(s) decompressed and their checksums verified "
                 "(a file cut short has no summary or file checksum)")
-    older = " (this log has no file checksum: an older cosim)" if o.data_checksum is False else ""
+    older = " (this log has no file checksum: older cosim versions wrote none)" if o.data_checksum is False else ""
     if o.check == "full":
         file = "the file's (every byte as written), " if o.data_checksum else ""
         agree = " (the summary agrees)" if o.summary_checked else ""

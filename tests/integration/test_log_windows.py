@@ -310,3 +310,37 @@ def test_a_summary_that_lies_about_a_chunk_is_refused(slow_log: Path, chunk_inde
                                        r"messages at t = [\d.]+ to"):
         list(iter_messages(both, [TOPIC_SENSORS], start / 1e9, start / 1e9 + 0.5))
     assert not (tmp_path / "o.csv").exists()
+
+
+def test_a_log_rewritten_by_the_mcap_package_is_windowed_through_its_index(slow_log: Path, whole_exports,
+                                                                           tmp_path: Path) -> None:  # noqa: ANN001
+    """Another writer's summary and chunk index (smaller chunks, no file checksum) serve windows alike."""
+    from mcap.writer import CompressionType, Writer
+
+    other = tmp_path / "other.mcap"
+    with open(slow_log, "rb") as source, open(other, "wb") as out:
+        reader = make_reader(source)
+        summary = reader.get_summary()
+        writer = Writer(out, compression=CompressionType.ZSTD, chunk_size=64 * 1024)
+        writer.start(profile="cosim", library="mcap")
+        schemas = {sid: writer.register_schema(s.name, s.encoding, s.data) for sid, s in summary.schemas.items()}
+        channels = {cid: writer.register_channel(c.topic, c.message_encoding, schemas[c.schema_id])
+                    for cid, c in summary.channels.items()}
+        for attachment in reader.iter_attachments():
+            writer.add_attachment(attachment.create_time, attachment.log_time, attachment.name,
+                                  attachment.media_type, attachment.data)
+        for metadata in reader.iter_metadata():
+            writer.add_metadata(metadata.name, metadata.metadata)
+        for _, channel, message in reader.iter_messages(log_time_order=False):
+            writer.add_message(channels[channel.id], message.log_time, message.data, message.publish_time,
+                               message.sequence)
+        writer.finish()
+    stats = ReadStats()
+    overview = open_log(other, check="file", stats=stats)
+    assert overview.data_checksum is False and stats.chunks == 1 and overview.chunks > 60
+    result = cosim_cli("info", str(other), cwd=tmp_path)
+    assert "the others not read (this log has no file checksum: older cosim versions wrote none)" in result.stdout
+    result = cosim_cli("export", str(other), "--from", "10", "--to", "12.5", "--csv", "w.csv", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    header, *rows = whole_exports[TOPIC_SENSORS]
+    assert (tmp_path / "w.csv").read_bytes() == header + b"".join(r for r in rows if inside(r, 10.0, 12.5))
