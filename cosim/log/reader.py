@@ -68,7 +68,6 @@ from mcap.records import (
     AttachmentIndex,
     Channel,
     Chunk,
-    ChunkIndex,
     DataEnd,
     Header,
     Metadata,
@@ -412,8 +411,33 @@ class _Summary:
 
 
 _SUMMARY_RECORDS: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.STATISTICS: Statistics,
-                                    Opcode.CHUNK_INDEX: ChunkIndex, Opcode.ATTACHMENT_INDEX: AttachmentIndex,
-                                    Opcode.METADATA_INDEX: MetadataIndex}
+                                    Opcode.ATTACHMENT_INDEX: AttachmentIndex, Opcode.METADATA_INDEX: MetadataIndex}
+_CHUNK_INDEX_HEAD = struct.Struct("<QQQQI")  # message start and end time, chunk offset and length, map length
+_CHUNK_INDEX_ENTRY = struct.Struct("<HQ")  # channel id, offset of its message index
+_U32, _U64 = struct.Struct("<I"), struct.Struct("<Q")
+
+
+def _chunk_index(data: bytes, position: int, length: int) -> tuple[int, int, int, int, frozenset[int]]:
+    """A chunk index record's (start, end, chunk offset, chunk length, channel ids).
+
+    Parsed with ``struct`` rather than mcap's record reader, which costs 50 us a record: a day-long log's
+    summary has 17 000 of them, read by every window and overview.
+
+    Raises:
+        ValueError: the record is malformed (its fields do not fill it exactly).
+    """
+    end = position + length
+    start_time, end_time, offset, chunk_length, map_length = _CHUNK_INDEX_HEAD.unpack_from(data, position)
+    position += _CHUNK_INDEX_HEAD.size
+    if map_length % _CHUNK_INDEX_ENTRY.size or position + map_length > end:
+        raise ValueError("a message index map that does not fit")
+    ids = frozenset(cid for cid, _ in _CHUNK_INDEX_ENTRY.iter_unpack(data[position:position + map_length]))
+    position += map_length + _U64.size  # the message indexes' length
+    (compression_length,) = _U32.unpack_from(data, position)
+    position += _U32.size + compression_length + 2 * _U64.size  # compression, compressed and uncompressed size
+    if position != end:
+        raise ValueError("fields that do not fill the record")
+    return start_time, end_time, offset, chunk_length, ids
 
 
 def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
@@ -459,7 +483,13 @@ def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
         if length > len(data) - body:
             raise _corrupt(path, f"a record of the summary at offset {start + position} runs past its end")
         reader = _SUMMARY_RECORDS.get(opcode)
-        if reader is not None:
+        if opcode == Opcode.CHUNK_INDEX:
+            try:
+                found.setdefault(opcode, []).append(_chunk_index(data, body, length))
+            except (ValueError, struct.error):
+                raise _corrupt(path, f"a malformed ChunkIndex record in the summary (offset {start + position})"
+                               ) from None
+        elif reader is not None:
             stream = ReadDataStream(io.BytesIO(data[body:body + length]))
             try:
                 record = reader.read(stream)
@@ -471,22 +501,18 @@ def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
             found.setdefault(opcode, []).append(record)
         position = body + length
     statistics = found.get(Opcode.STATISTICS, [])
-    indexes: list[ChunkIndex] = sorted(found.get(Opcode.CHUNK_INDEX, []), key=lambda c: c.chunk_start_offset)
+    indexes = sorted(found.get(Opcode.CHUNK_INDEX, []), key=lambda c: c[2])
     channels = {c.id: c for c in found.get(Opcode.CHANNEL, [])}
     if len(statistics) != 1 or statistics[0].chunk_count != len(indexes) \
             or any(n and cid not in channels for cid, n in statistics[0].channel_message_counts.items()):
         return None  # written without statistics, a chunk index or the channels
     chunks = []
-    for number, index in enumerate(indexes, start=1):
-        if not (len(MAGIC) <= index.chunk_start_offset
-                and index.chunk_start_offset + index.chunk_length <= data_end
-                and index.chunk_length >= _RECORD_HEAD.size + _CHUNK_TIMES.size
-                and index.message_start_time <= index.message_end_time):
+    for number, (start_time, end_time, offset, chunk_length, ids) in enumerate(indexes, start=1):
+        if not (len(MAGIC) <= offset and offset + chunk_length <= data_end
+                and chunk_length >= _RECORD_HEAD.size + _CHUNK_TIMES.size and start_time <= end_time):
             raise _corrupt(path, f"the summary's index of chunk {number} points outside the data section "
-                                 f"(offset {index.chunk_start_offset}, {index.chunk_length} bytes)")
-        chunks.append(_ChunkEntry(number, index.chunk_start_offset, index.chunk_length - _RECORD_HEAD.size,
-                                  index.message_start_time, index.message_end_time,
-                                  frozenset(index.message_index_offsets)))
+                                 f"(offset {offset}, {chunk_length} bytes)")
+        chunks.append(_ChunkEntry(number, offset, chunk_length - _RECORD_HEAD.size, start_time, end_time, ids))
     for index in [*found.get(Opcode.ATTACHMENT_INDEX, []), *found.get(Opcode.METADATA_INDEX, [])]:
         if not (len(MAGIC) <= index.offset and index.offset + index.length <= data_end):
             raise _corrupt(path, f"the summary's index of {index.name!r} points outside the data section")
