@@ -303,6 +303,10 @@ def test_a_summary_that_lies_about_a_chunk_is_refused(slow_log: Path, chunk_inde
     one_line_error(cosim_cli("info", "--verify", str(lying), cwd=tmp_path),
                    f"the summary's chunk index does not match the chunks (it lists {len(chunks)}, the file holds "
                    f"{len(chunks)}; they differ from chunk {k + 1} on)")
+    # A malformed index record (its message index map one byte short), checksum made to match.
+    malformed = with_summary_crc(damaged_copy(slow_log, tmp_path / "malformed.mcap",
+                                              {index_at + 9 + 32: struct.pack("<I", 9)}))
+    one_line_error(cosim_cli("info", str(malformed), cwd=tmp_path), "a malformed ChunkIndex record in the summary")
     # The chunk's own header changed too, consistently: its messages still give it away.
     header_at = chunks[k].chunk_start_offset + 9
     both = with_summary_crc(damaged_copy(slow_log, tmp_path / "both.mcap", {index_at + 9: later, header_at: later}))
