@@ -131,6 +131,55 @@ def sensor_histories(t: npt.ArrayLike, series: Mapping[str, npt.ArrayLike], unit
     return names
 
 
+# --------------------------------------------------------------------------- network around a bridge
+
+
+def network_figure(lanes: Sequence[npt.ArrayLike], junction_lanes: Sequence[npt.ArrayLike],
+                   deck_lanes: Sequence[npt.ArrayLike], outline: npt.ArrayLike, axis: npt.ArrayLike, title: str,
+                   path: str | Path, extent: tuple[float, float, float, float] | None = None) -> None:
+    """Draw the road network around a bridge, in network coordinates (m), equal scales.
+
+    Args:
+        lanes: centre lines (n, 2) of the other lanes (grey); junction_lanes: of the junctions' internal
+            lanes (light grey, dotted); deck_lanes: of the deck's lanes (blue).
+        outline: the deck's carriageway outline, a closed polygon (k, 2).
+        axis: the axis, start and end (2, 2): drawn as an arrow from x = 0 to x = L.
+        title: the figure's title; path: the figure file (its suffix picks the format).
+        extent: (x_min, x_max, y_min, y_max) shown, m (default: everything drawn).
+    """
+    fig = _figure(7.5, 6.5)
+    ax = fig.add_subplot()
+    for i, pts in enumerate(lanes):
+        p = np.asarray(pts, dtype=float)
+        ax.plot(p[:, 0], p[:, 1], color="0.55", linewidth=0.8, label="lanes" if i == 0 else None)
+    for i, pts in enumerate(junction_lanes):
+        p = np.asarray(pts, dtype=float)
+        ax.plot(p[:, 0], p[:, 1], color="0.75", linewidth=0.7, linestyle=":",
+                label="junction lanes" if i == 0 else None)
+    box = np.asarray(outline, dtype=float)
+    ax.fill(box[:, 0], box[:, 1], color="tab:orange", alpha=0.25, linewidth=0, label="deck (carriageway)")
+    ax.plot(box[:, 0], box[:, 1], color="tab:orange", linewidth=1.0)
+    for i, pts in enumerate(deck_lanes):
+        p = np.asarray(pts, dtype=float)
+        ax.plot(p[:, 0], p[:, 1], color="tab:blue", linewidth=1.4, label="deck lanes" if i == 0 else None)
+    a = np.asarray(axis, dtype=float)
+    ax.annotate("", xy=a[1], xytext=a[0], arrowprops={"arrowstyle": "->", "color": "tab:red", "linewidth": 1.5})
+    ax.plot(a[:, 0], a[:, 1], color="tab:red", linewidth=1.5, label="axis, x = 0 -> L")
+    ax.annotate("x = 0", a[0], fontsize=8, color="tab:red", xytext=(4, 4), textcoords="offset points")
+    if extent is not None:
+        ax.set_xlim(extent[0], extent[1])
+        ax.set_ylim(extent[2], extent[3])
+        ax.set_aspect("equal", adjustable="box")
+    else:
+        ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("network x [m]")
+    ax.set_ylabel("network y [m]")
+    ax.grid(True, linewidth=0.4, alpha=0.5)
+    ax.legend(fontsize=8, loc="best")
+    ax.set_title(title, fontsize=10)
+    _save(fig, path, dpi=110)
+
+
 # --------------------------------------------------------------------------- studies
 
 
@@ -240,6 +289,37 @@ def _sweep_panel(ax: Any, table: Any, axes: Mapping[str, Sequence[Any]], axis: s
         ax.set_xticks([positions[v] for v in values], [ticks.get(v, str(v)) for v in values])
     if any(label for label, _ in groups):
         ax.legend(fontsize=7)
+
+
+# --------------------------------------------------------------------------- extremes
+
+
+def return_level_plot(samples_years: npt.ArrayLike, samples: npt.ArrayLike, curve_years: npt.ArrayLike,
+                      curve: npt.ArrayLike, target: tuple[float, float, float, float], *, label: str, title: str,
+                      path: str | Path) -> Path:
+    """A return-level plot: the fitted law's level against the return period (years, log scale), the data at
+    their plotting positions, and the target return level with its confidence interval.
+
+    Args:
+        samples_years, samples: the data's empirical return periods (years) and values, in display units.
+        curve_years, curve: the fitted return-level curve.
+        target: (return period, level, lower bound, upper bound) of the characteristic value.
+        label: the y-axis label (quantity and unit); title: the figure's title; path: the file.
+    """
+    years, level, lower, upper = target
+    fig = _figure(6.4, 4.2)
+    ax = fig.subplots()
+    ax.semilogx(curve_years, curve, "-", linewidth=1.4, label="fitted law")
+    ax.semilogx(samples_years, samples, "o", color="0.35", markersize=3.5, label="data (Gringorten positions)")
+    ax.errorbar([years], [level], yerr=[[level - lower], [upper - level]], fmt="s", color="C3", capsize=4,
+                label=f"{years:g}-year value {level:.4g} [{lower:.4g}, {upper:.4g}]")
+    ax.set_xlabel("return period [years]")
+    ax.set_ylabel(label, fontsize=9)
+    ax.grid(True, which="both", linewidth=0.4, alpha=0.5)
+    ax.legend(fontsize=7)
+    ax.set_title(title, fontsize=9)
+    _save(fig, path, dpi=110)
+    return Path(path)
 
 
 # --------------------------------------------------------------------------- validation

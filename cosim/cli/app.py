@@ -1,6 +1,6 @@
 """The ``cosim`` command line: the parser, :func:`main` and how errors become exit statuses.
 
-Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
+Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.layout`, :mod:`.modes`,
 :mod:`.static`, :mod:`.study`, :mod:`.validate`)::
 
     cosim modes SCENARIO [--count N] [--json] [--plot FILE.png]
@@ -10,8 +10,11 @@ Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.modes`,
     cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--from T0] [--to T1] [--force]
     cosim info LOG.mcap [--verify]
     cosim plot LOG.mcap [--sensor NAME ...] [--from T0] [--to T1] -o FIG.png [--force]
+    cosim layout LOG.mcap -o LAYOUT.json [--force]
     cosim validate [--out DIR] [--quick]
     cosim study STUDY.toml [--workers N] ...
+    cosim dataset SPEC.toml [--out FOLDER] [--force]
+    cosim bridge NET_OR_SUMOCFG [--edge ID ...] [--near X Y] [--plot FIG.png]
 
 The work is done by :mod:`cosim.run` (and :mod:`cosim.study`,
 :mod:`cosim.validation`); the command line parses, checks and prints, and is
@@ -39,6 +42,9 @@ from cosim.run.export import EXPORT_TOPICS
 from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
+from .bridge import DEFAULT_COUNT, cmd_bridge
+from .dataset import cmd_dataset
+from .layout import cmd_layout
 from .logs import cmd_export, cmd_info, cmd_plot
 from .modes import cmd_modes
 from .run import DEFAULT_SCENARIO, cmd_replay, cmd_run
@@ -101,6 +107,7 @@ def build_parser() -> argparse.ArgumentParser:
               cosim info run1.mcap
               cosim export run1.mcap --csv run1.csv
               cosim plot run1.mcap -o run1.png
+              cosim layout run1.mcap -o run1-layout.json   # for Foxglove
               cosim replay run1.mcap --scenario other-bridge.toml
               cosim modes paper-double-tee --count 12 --plot modes.png
               cosim static paper-double-tee --load 20 3.325 -100e3
@@ -218,7 +225,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=textwrap.dedent(
             f"""\
             examples:
-              cosim run                              # the default traffic run -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run                              # the default traffic run
+                                                     # -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
               cosim run paper-double-tee             # the paper's two quarter-cars
               cosim run my-bridge.toml --out results/run1.mcap --csv results/run1.csv
               cosim run my-bridge-no-vehicles.toml --out summary.json
@@ -366,6 +374,29 @@ def build_parser() -> argparse.ArgumentParser:
     plot._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
     plot.set_defaults(func=cmd_plot)
 
+    layout = commands.add_parser(
+        "layout",
+        help="write the Foxglove layout made for a log's run",
+        description=textwrap.dedent(
+            """\
+            Write the Foxglove layout of a log's run, the one the run attached to its log
+            (foxglove_layout.json), made from what the log records: a plot per sensor
+            quantity with its sensors, the vehicles' contact forces (per vehicle for
+            scripted vehicles, all together for SUMO traffic), the positions of the traffic
+            near the deck, a table of the vehicles on the deck, the events and status, and
+            the 3D scene of the deck and its vehicles when the log has one. Logs written
+            before layouts existed get one too. Open the log in Foxglove (desktop app or
+            app.foxglove.dev: Open local file) and import the layout with Layouts ->
+            Import from file. An existing file is replaced only with --force, never the log."""
+        ),
+        epilog="examples:\n  cosim layout runs/run1.mcap -o run1-layout.json\n",
+        formatter_class=formatter,
+    )
+    layout.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    layout.add_argument("-o", "--output", required=True, metavar="LAYOUT.json", help="the layout file to write")
+    layout.add_argument("--force", "-f", action="store_true", help="overwrite LAYOUT.json if it exists")
+    layout.set_defaults(func=cmd_layout)
+
     validate = commands.add_parser(
         "validate",
         help="run the verification and validation cases; write a report with plots",
@@ -435,6 +466,57 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--no-plots", action="store_true", help="write the table only")
     study.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     study.set_defaults(func=cmd_study)
+
+    dataset = commands.add_parser(
+        "dataset",
+        help="write a labelled monitoring dataset (healthy and damaged, temperature, instruments)",
+        description="Run a base scenario window by window for every damage case of the dataset file, measure the "
+                    "responses with its instruments (anti-aliasing, sampling, noise, quantisation) and write one "
+                    "row per window with its labels to dataset.parquet, plus the MCAP logs. docs/analysis.md "
+                    "documents the dataset file.",
+    )
+    dataset.add_argument("dataset", metavar="SPEC.toml", help="the dataset file")
+    dataset.add_argument("--out", metavar="FOLDER",
+                         help="the output folder (default: [dataset].output, else datasets/<name>)")
+    dataset.add_argument("--force", action="store_true", help="overwrite an existing dataset and its logs")
+    dataset.add_argument("--quiet", "-q", action="store_true", help="no progress on stderr")
+    dataset.set_defaults(func=cmd_dataset)
+    bridge = commands.add_parser(
+        "bridge",
+        help="find a bridge in a SUMO network: candidates, or one bridge's axis, lanes and scenario lines",
+        description=textwrap.dedent(
+            """\
+            Without --edge: list candidate bridges of a SUMO network (or of the network a
+            .sumocfg names): two-way edge pairs between two junctions and one-way edges,
+            with length, lanes, street names and the OSM bridge attribute where the network
+            kept them; edges marked as OSM bridges first, then the nearest to --near X Y
+            (network coordinates), else the longest.
+
+            With --edge (repeat it for each edge the deck carries): the bridge's axis (the
+            carriageway's centre line, x = 0 where the named lanes begin, +x the first edge's
+            direction of travel), length, lanes and their lateral positions, the junctions at
+            its ends, and the [bridge]/[traffic] lines to paste into a scenario; --plot draws
+            the network around it with the deck outline, the axis and the lanes."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim bridge city.sumocfg --near 720 230
+              cosim bridge city.sumocfg --edge 39 --edge 40
+              cosim bridge city.net.xml.gz --edge 113 --edge "43[1]" --plot bridge.png
+            """
+        ),
+        formatter_class=formatter,
+    )
+    bridge.add_argument("network", metavar="NET_OR_SUMOCFG", help="a SUMO network (.net.xml[.gz]) or config (.sumocfg)")
+    bridge.add_argument("--edge", action="append", metavar="ID", help="an edge the deck carries (repeat for more)")
+    bridge.add_argument("--near", nargs=2, type=float, metavar=("X", "Y"),
+                        help="list the candidates nearest to this point (network coordinates, m) first")
+    bridge.add_argument("--count", "-n", type=positive_int, metavar="N",
+                        help=f"candidates to list (default: {DEFAULT_COUNT})")
+    bridge.add_argument("--plot", metavar="FIG.png", help="draw the network around the bridge (needs --edge)")
+    bridge.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
+    bridge.set_defaults(func=cmd_bridge)
     return parser
 
 

@@ -5,10 +5,12 @@ import argparse
 import json
 import sys
 
-from cosim.log.reader import LogOverview, file_is_complete, open_log
-from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_SENSORS
+from cosim.core.traffic import vehicle_of
+from cosim.log.reader import LogOverview, ReadStats, file_is_complete, iter_messages, open_log
+from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.run.export import export_csv
 from cosim.run.figures import plot_log_sensors
+from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 
 from .text import fmt_g, print_lines, size_text
 
@@ -85,7 +87,9 @@ def info_lines(o: LogOverview) -> list[str]:
         lines.append(f"Simulated: {fmt_g(o.end_time, 6)} s")
     sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
     lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
-    if "vehicles" in info:
+    if o.counts.get(TOPIC_TRAFFIC) or info.get("traffic") == "sumo":
+        lines.extend(_sumo_vehicle_lines(o))
+    elif "vehicles" in info:
         try:
             vehicles = json.loads(info["vehicles"])
             lines.append(f"Vehicles ({len(vehicles)}): {', '.join(vehicles) or 'none'}")
@@ -109,6 +113,52 @@ def info_lines(o: LogOverview) -> list[str]:
     atts = ", ".join(f"{name} ({size_text(len(data))})" for name, data in o.attachments.items()) or "none"
     lines.append(f"Attachments: {atts}")
     lines.append(checked_line(o))
+    return lines
+
+
+#: SUMO vehicles listed by name in ``cosim info`` (the rest are counted).
+SHOWN_VEHICLES = 20
+#: Chunks ``cosim info`` (without --verify) reads for the SUMO vehicles' events: about 20 min of the default run.
+EVENT_CHUNKS = 256
+
+
+def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
+    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run.
+
+    Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
+    thousands): the vehicles of a long log are those of its start, and the line says so.
+    """
+    axles: dict[str, int] = {}
+    stats = ReadStats()
+    budget = None if o.check == "full" else EVENT_CHUNKS
+    last_t, cut = 0.0, False
+    if o.counts.get(TOPIC_EVENTS):
+        # A window over the whole log: a finished log's chunks are then read through its index, one at a time.
+        messages = iter_messages(o.path, [TOPIC_EVENTS], start=o.start_time, stats=stats)
+        for _, message in messages:
+            if budget is not None and stats.chunks > budget:
+                cut = True
+                break
+            last_t = float(message["t"])
+            if message.get("event") == "entered":
+                contact = str(message.get("vehicle", ""))
+                axles.setdefault(contact, 0)
+        messages.close()  # type: ignore[attr-defined]
+    vehicles = list(dict.fromkeys(vehicle_of(c) for c in axles))
+    shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"
+                                                    if len(vehicles) > SHOWN_VEHICLES else "")
+    axle_text = f", {len(axles)} axles" if len(axles) != len(vehicles) else ""
+    when = f" in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
+    lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{when}{axle_text}): {shown or 'none'}"]
+    raw = o.attachments.get(VEHICLE_TYPES_ATTACHMENT)
+    if raw is not None:
+        try:
+            types = json.loads(raw)
+            rows = [f"  {t['type']} ({t['vclass']}): {t['model']}, {float(t['mass']):.0f} kg ({t['sources']['mass']}), "
+                    f"{len(t['axles'])} axle(s) ({t['sources']['axles']})" for t in types]
+            lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
+        except (ValueError, KeyError, TypeError):
+            lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
     return lines
 
 

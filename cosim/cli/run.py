@@ -23,6 +23,7 @@ from cosim.run.outputs import atomic_write, check_new_file, check_not_input, che
 from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
 from cosim.run.replay import Comparison, compare_sensors, replay_scenario
 from cosim.run.scenario import Scenario, load_scenario
+from cosim.run.simulate import SumoPlan, plan_sumo
 from cosim.run.static import STATIC_LOAD_N, static_cases
 from cosim.run.units import display_unit
 
@@ -188,20 +189,49 @@ def _parameter_text(key: str, value: Any) -> str:
     return f"{key} = {fmt_g(value)} {_PARAMETER_UNITS[key]}"
 
 
-def _traffic_line(scenario: Scenario) -> str:
+def _traffic_line(scenario: Scenario, plan: SumoPlan | None = None) -> str:
     t = scenario.traffic
     assert t is not None
     level = f" (bundled {t.sumo_config} demand)" if t.bundled else ""
     seed = f", seed {t.seed}" if t.seed is not None else ", the config's seed"
-    axis = t.axis or ((0.0, 0.0), (scenario.bridge.length, 0.0))
     where = f"sumo_networks/{t.sumo_config}.sumocfg" if t.bundled else str(scenario.sumo_config_path)
+    if plan is not None:
+        start, end = plan.axis.start, plan.axis.end
+        axis = (f"bridge axis ({start[0]:.3f}, {start[1]:.3f}) -> ({end[0]:.3f}, {end[1]:.3f}) in network "
+                f"coordinates, {plan.axis.length:.3f} m ({plan.axis_from})")
+    elif t.axis is not None:
+        axis = f"bridge axis {t.axis[0]} -> {t.axis[1]} in network coordinates"
+    elif t.edges:
+        axis = f"bridge axis derived from edges {', '.join(t.edges)}"
+    else:
+        axis = f"bridge axis {(0.0, 0.0)} -> {(scenario.bridge.length, 0.0)} in network coordinates"
     return (f"Traffic: SUMO {where}{level}, step {fmt_g(t.step)} s, SUMO time {fmt_g(t.begin)} to "
-            f"{fmt_g(t.end)} s{seed}; bridge axis {axis[0]} -> {axis[1]} in network coordinates")
+            f"{fmt_g(t.end)} s{seed}; {axis}")
 
 
-def _vehicle_lines(scenario: Scenario) -> list[str]:
+def _sumo_lines(plan: SumoPlan) -> list[str]:
+    """Where the deck is in the network, and one line per vType: model, mass, axles and where each came from."""
+    lines = []
+    location = plan.location
+    if location is not None:
+        lanes = ", ".join(f"{lane.id} (y = {lane.y:+.2f} m, {'+x' if lane.direction > 0 else '-x'})"
+                          for lane in location.lanes)
+        also = f"; also watched: {', '.join(location.opposite)} (opposite direction)" if location.opposite else ""
+        lines.append(f"Deck lanes: {lanes}; carriageway y = {location.carriageway[0]:.2f} to "
+                     f"{location.carriageway[1]:.2f} m{also}")
+    types = plan.types
+    lines.append(f"Vehicle types ({len(types)}): model, gross mass, axles, suspension, and where each came from "
+                 "(vType params, SUMO mass, cosim default)")
+    width = max([len(t.id) for t in types] + [4])
+    vwidth = max([len(t.vclass) for t in types] + [6])
+    for t in types:
+        lines.append(f"  {t.id:<{width}}  {t.vclass:<{vwidth}}  {t.line()}")
+    return lines
+
+
+def _vehicle_lines(scenario: Scenario, plan: SumoPlan | None = None) -> list[str]:
     if scenario.traffic is not None:
-        return [_traffic_line(scenario)]
+        return [_traffic_line(scenario, plan), *(_sumo_lines(plan) if plan is not None else [])]
     rows = []
     for v in scenario.vehicles:
         if v.profile is not None:
@@ -278,6 +308,22 @@ def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - 
     return lines
 
 
+def _fatigue_summary(outcome: RunOutcome) -> list[str]:
+    """Rainflow and Miner damage of the stress sensors with an S-N curve (none: no lines)."""
+    if not outcome.fatigue:
+        return []
+    width = max(len("name"), *(len(n) for n in outcome.fatigue))
+    curve_width = max(len("S-N curve"), *(len(r.curve.name) for r in outcome.fatigue.values()))
+    lines = ["Fatigue: rainflow count of the logged samples, Miner damage; per year: the run's traffic all year",
+             f"  {'name':<{width}}  {'S-N curve':<{curve_width}}{'cycles':>10}{'damage':>12}{'per year':>12}"
+             f"{'eq. range':>11}{'max range':>11}  unit"]
+    for name, r in outcome.fatigue.items():
+        per_year = r.damage_per_year if r.damage_per_year is not None else float("nan")
+        lines.append(f"  {name:<{width}}  {r.curve.name:<{curve_width}}{r.cycles:10.4g}{r.damage:12.4g}"
+                     f"{per_year:12.4g}{r.equivalent_stress_range * 1e-6:11.4g}{r.max_stress_range * 1e-6:11.4g}  MPa")
+    return lines
+
+
 def _vehicle_summary(outcome: RunOutcome, limit: int = 12) -> list[str]:
     result = outcome.result
     scripted = [v.id for v in outcome.scenario.vehicles]
@@ -334,13 +380,14 @@ def _log_done_line(outcome: RunOutcome) -> str:
             f"at {fmt_g(outcome.rate_hz, 4)} Hz from t = 0; status finished)")
 
 
-def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path, duration: float | None = None) -> list[str]:
+def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path, duration: float | None = None,
+                  plan: SumoPlan | None = None) -> list[str]:
     spans = " + ".join(f"{span:g}" for span in bridge.spans)
     replayed = not scenario.vehicles and scenario.traffic is None
     return [
         f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
         *damping_lines(bridge),
-        *(["Traffic: the replayed log's SUMO frames"] if replayed else _vehicle_lines(scenario)),
+        *(["Traffic: the replayed log's SUMO frames"] if replayed else _vehicle_lines(scenario, plan)),
         _road_line(scenario),
         _solver_line(scenario, duration if duration is not None else scenario.duration),
         _logging_line(scenario, log_path),
@@ -378,6 +425,7 @@ def _print_outcome(scenario: Scenario, outcome: RunOutcome) -> None:
     """The end-of-run summary: sensor peaks, vehicles, counters, the log written."""
     print()
     print_lines(_sensor_summary(scenario, outcome.result))
+    print_lines(_fatigue_summary(outcome))
     print_lines(_vehicle_summary(outcome))
     print_lines(_run_lines(outcome))
     print(_log_done_line(outcome))
@@ -393,9 +441,11 @@ def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
     if csv_path is not None:
         check_not_input(csv_path, "sensor CSV", [*inputs, ("the run's log (--out)", log_path)])
         check_new_file(csv_path, "sensor CSV", args.force)
+    # SUMO: the network and demand are read (and a wrong edge or vType reported) before anything is written.
+    plan = plan_sumo(scenario) if scenario.traffic is not None else None
     print(scenario_line(scenario))
     bridge = scenario.build_bridge()
-    print_lines(_header_lines(scenario, bridge, log_path))
+    print_lines(_header_lines(scenario, bridge, log_path, plan=plan))
     status, outcome = _simulate_logged(scenario, bridge, log_path, args)
     if outcome is None:
         return status

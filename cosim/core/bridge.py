@@ -82,6 +82,9 @@ _PURE_KIND_SHARE = 0.75
 MECHANISM_PIVOT = 1e-11
 
 SupportSpec = Union[str, Sequence[str]]
+#: Stress resultants :meth:`BridgeModel.field_row` gives (docs/theory.md §12.2).
+RESULTANTS: tuple[str, ...] = ("axial_force", "bending_moment", "shear_force_y", "shear_force_z", "torque_sv",
+                               "bimoment")
 
 
 @dataclass(frozen=True)
@@ -356,32 +359,58 @@ class BridgeModel:
         dofs = NODE_DOFS * e[:, None] + np.arange(ELEMENT_DOFS)[None, :]
         return dofs, values
 
-    def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0) -> DeckRow:
+    def field_row(self, name: str, x: float, y: float = 0.0, order: int = 0, *, z: float = 0.0,
+                  omega: float = 0.0) -> DeckRow:
         """Row mapping the element DOFs at ``x`` (m) to a field value.
 
         ``name`` is one of u, v, w, theta_x, theta_y, theta_z, psi (interpolated with
         the element's shape functions; psi = theta_x' for Vlasov torsion), ``w_deck`` (the
         vertical displacement of the deck point at lateral position ``y``, m),
-        or ``bending_moment`` (vertical bending moment about the centroidal y
+        ``bending_moment`` (vertical bending moment about the centroidal y
         axis, N m, sagging positive: ``M = -E (I_y theta_y' - I_yz theta_z')``,
-        which is ``E I_y w''`` for Euler-Bernoulli bending). ``order`` adds
-        x-derivatives. Only ``values[0]`` of the returned row is filled.
+        which is ``E I_y w''`` for Euler-Bernoulli bending), or one of the
+        stress resultants and the strain of docs/theory.md §12:
+
+        - ``axial_force`` ``N = E A u'`` (N, tension positive);
+        - ``shear_force_y`` ``V_y = -E (I_z theta_z'' - I_yz theta_y'')`` and
+          ``shear_force_z`` ``V_z = E (I_y theta_y'' - I_yz theta_z'')`` (N, on the
+          face whose outward normal is +x, along +y and +z; from equilibrium
+          with the bending moments, so they hold for both bending theories);
+        - ``torque_sv`` ``T_sv = G J theta_x'`` (N m, the St Venant part of the torque);
+        - ``bimoment`` ``B = -E I_w psi'`` (N m^2; ``sigma = B omega / I_w``);
+        - ``normal_strain`` ``eps_x = u' + (z - z_c) theta_y' - (y - y_c) theta_z' - omega psi'``
+          at the section point ``(y, z)`` whose sectorial coordinate is ``omega`` (m^2).
+
+        ``order`` adds x-derivatives. Only ``values[0]`` of the returned row is filled.
         """
         e, xi = self.locate(x)
         lengths, phi_y, phi_z, phi_t = self._element_data
-        extra = 1 if name == "bending_moment" else 0
+        extra = {"bending_moment": 1, "axial_force": 1, "torque_sv": 1, "bimoment": 1, "normal_strain": 1,
+                 "shear_force_y": 2, "shear_force_z": 2}.get(name, 0)
         n = field_matrix(xi, lengths[e], phi_y[e], phi_z[e], order + extra, phi_t[e])[0]
+        sec, mat = self.section, self.material
+        ty, tz = n[FIELD_INDEX["theta_y"]], n[FIELD_INDEX["theta_z"]]
         if name == "bending_moment":
-            sec = self.section
-            row = -self.material.E * (sec.I_y * n[FIELD_INDEX["theta_y"]] - sec.I_yz * n[FIELD_INDEX["theta_z"]])
+            row = -mat.E * (sec.I_y * ty - sec.I_yz * tz)
+        elif name == "shear_force_z":
+            row = mat.E * (sec.I_y * ty - sec.I_yz * tz)
+        elif name == "shear_force_y":
+            row = -mat.E * (sec.I_z * tz - sec.I_yz * ty)
+        elif name == "axial_force":
+            row = mat.E * sec.A * n[FIELD_INDEX["u"]]
+        elif name == "torque_sv":
+            row = mat.G * sec.J * n[FIELD_INDEX["theta_x"]]
+        elif name == "bimoment":
+            row = -mat.E * sec.I_w * n[FIELD_INDEX["psi"]]
+        elif name == "normal_strain":
+            row = (n[FIELD_INDEX["u"]] + (z - sec.z_c) * ty - (y - sec.y_c) * tz - omega * n[FIELD_INDEX["psi"]])
         elif name == "w_deck":
             row = n[FIELD_INDEX["w"]] + (y - self.section.y_s) * n[FIELD_INDEX["theta_x"]]
         elif name in FIELD_INDEX:
             row = n[FIELD_INDEX[name]]
         else:
-            raise ModelError(
-                f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, w_deck, bending_moment)"
-            )
+            raise ModelError(f"unknown field {name!r} (expected one of: {', '.join(FIELD_INDEX)}, w_deck, "
+                             f"{', '.join(RESULTANTS)}, normal_strain)")
         return DeckRow(dofs=self._element_dofs(e), values=row[None, :])
 
     def field(
@@ -550,6 +579,8 @@ def build_bridge(
     supports: Sequence[SupportSpec],
     damping: Union[RayleighDamping, ExplicitDamping, None] = None,
     theory: BeamTheory | None = None,
+    stiffness_factors: Sequence[float] | npt.ArrayLike | None = None,
+    support_springs: Sequence[tuple[int, str, float]] = (),
 ) -> BridgeModel:
     """Assemble a continuous beam bridge.
 
@@ -563,6 +594,12 @@ def build_bridge(
         damping: Rayleigh damping from two modes' ratios, explicit alpha/beta, or None.
         theory: torsion ("vlasov" | "benscoter") and bending ("timoshenko" |
             "euler-bernoulli") theories; default Vlasov and Timoshenko (the seed's element).
+        stiffness_factors: one factor per element (from x = 0) on its stiffness matrix: damage such as
+            cracking over a length of the deck (a factor 0.5 halves every stiffness of the element: E A,
+            E I, G A_s, G J, E I_w); default 1 everywhere. The mass is not changed. Stress rows still use
+            the material's E.
+        support_springs: (support line index, DOF name, stiffness) for a degraded support: that DOF of the
+            support line is no longer held but sits on a spring (N/m for translations, N m/rad for rotations).
 
     Returns:
         The assembled, immutable :class:`BridgeModel`.
@@ -598,6 +635,10 @@ def build_bridge(
     n_nodes = len(nodes_x)
     ndof = NODE_DOFS * n_nodes
     lengths = np.diff(nodes_x)
+    factors = np.ones(len(lengths)) if stiffness_factors is None else np.asarray(stiffness_factors, dtype=float)
+    if factors.shape != lengths.shape or not np.all(np.isfinite(factors)) or np.any(factors <= 0):
+        raise ConfigError(f"`stiffness_factors` must be {len(lengths)} numbers > 0, one per element "
+                          f"(got {len(factors.ravel())})")
 
     # Element matrices depend only on the length: compute once per distinct length.
     cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
@@ -611,16 +652,29 @@ def build_bridge(
         dofs = NODE_DOFS * e + local
         rows.append(np.repeat(dofs, ELEMENT_DOFS))
         cols.append(np.tile(dofs, ELEMENT_DOFS))
-        kv.append(k_e.ravel())
+        kv.append(factors[e] * k_e.ravel())
         mv.append(m_e.ravel())
     rows_a, cols_a = np.concatenate(rows), np.concatenate(cols)
     K = sp.csr_matrix((np.concatenate(kv), (rows_a, cols_a)), shape=(ndof, ndof))
     M = sp.csr_matrix((np.concatenate(mv), (rows_a, cols_a)), shape=(ndof, ndof))
 
     support_nodes = np.concatenate([[0], np.cumsum(n_per)])
-    restrained = sorted(
-        {NODE_DOFS * int(node) + DOF_INDEX[name] for node, names in zip(support_nodes, support_sets) for name in names}
-    )
+    restrained_set = {NODE_DOFS * int(node) + DOF_INDEX[name]
+                      for node, names in zip(support_nodes, support_sets) for name in names}
+    springs = np.zeros(ndof)
+    for line, name, stiffness in support_springs:
+        if not (isinstance(line, (int, np.integer)) and 0 <= line < len(support_nodes)):
+            raise ConfigError(f"a support spring's support line must be 0 ... {len(support_nodes) - 1} (got {line!r})")
+        if name not in DOF_INDEX:
+            raise ConfigError(f"unknown DOF {name!r} of a support spring (expected one of: {', '.join(DOF_NAMES)})")
+        if not (np.isfinite(stiffness) and stiffness > 0):
+            raise ConfigError(f"a support spring's stiffness must be > 0 (got {stiffness!r})")
+        dof = NODE_DOFS * int(support_nodes[line]) + DOF_INDEX[name]
+        restrained_set.discard(dof)
+        springs[dof] += float(stiffness)
+    if np.any(springs):
+        K = (K + sp.diags(springs)).tocsr()
+    restrained = sorted(restrained_set)
     bridge = BridgeModel(
         spans=spans,
         nodes_x=nodes_x,

@@ -117,7 +117,7 @@ def _linear_groups(ids: tuple[str, ...], models: tuple[VehicleModel, ...], kind:
         owner = vehicle_of(ids[j])
         expected = [f"{owner}{AXLE_SEPARATOR}{k}" for k in range(count)] if count > 1 else [ids[j]]
         if len(ids) < j + count or [ids[c] for c in cols] != expected or \
-                any(models[c] is not model for c in cols):
+                any(models[c] != model for c in cols):
             raise ConfigError(f"vehicle {owner}: its {count} axles must come together as {', '.join(expected)} "
                               "(one contact column per axle, in order, with the same model)")
         groups.append(cols)

@@ -34,7 +34,7 @@ from .sensors import Sensor, sensor_row
 from .traffic import TrafficSource, vehicle_of
 
 #: Sensor quantities that have a quasi-static response (and hence a DAF).
-STATIC_QUANTITIES = ("displacement", "bending_moment")
+STATIC_QUANTITIES = ("displacement", "bending_moment", "stress", "strain", "shear_stress_xy", "shear_stress_xz")
 
 
 def influence_vectors(bridge: BridgeModel, sensors: Sequence[Sensor]) -> npt.NDArray[np.float64]:

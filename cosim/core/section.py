@@ -10,7 +10,8 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -88,6 +89,9 @@ class SectionProperties:
             translational inertia (and its coupling with the twist); None: ``rho A``.
         rotary_inertia: whether the bending rotations carry inertia ``rho I_y``,
             ``rho I_z`` (False for a classical Euler-Bernoulli beam).
+        stress_field: the section's finite-element mesh with the warping function and the
+            shear stresses per unit force (:class:`SectionField`), for stress sensors;
+            None for explicit constants (no geometry). Not part of equality.
     """
 
     A: float
@@ -107,6 +111,7 @@ class SectionProperties:
     I_ws: float | None = None
     mass_per_length: float | None = None
     rotary_inertia: bool = True
+    stress_field: SectionField | None = field(default=None, compare=False, repr=False)
 
     @property
     def I_ps(self) -> float:
@@ -122,6 +127,88 @@ class SectionProperties:
     def k_z(self) -> float:
         """Shear coefficient for vertical shear, A_sz / A."""
         return self.A_sz / self.A
+
+
+#: A point this far outside every triangle (in area coordinates) still counts as inside: a point on the boundary.
+_INSIDE_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class SectionField:
+    """The section's finite-element mesh and the fields a stress sensor reads at a point (docs/theory.md §12).
+
+    Kept from the section solve of :func:`section_from_plates`. The warping
+    function is the principal sectorial coordinate ``omega`` of (1.3) with the
+    sign of the displacement field (1.2), ``u_x = ... - omega psi``: the
+    Saint-Venant warping function of sectionproperties moved to the Trefftz
+    shear centre S, less its mean, with the sign reversed. The shear stresses per
+    unit force (Saint-Venant torsion and the flexure solution) are
+    sectionproperties' own, computed on first use.
+
+    Attributes:
+        nodes: (n, 2) node coordinates (y, z), m, in the section's frame.
+        elements: (n_el, 6) node ids of the quadratic triangles (corners, then the mid-sides 1-2, 2-3, 3-1).
+        omega: (n,) the principal sectorial coordinate about S at the nodes, m^2.
+        solved: the solved ``sectionproperties`` Section (for the shear stresses).
+    """
+
+    nodes: np.ndarray
+    elements: np.ndarray
+    omega: np.ndarray
+    solved: Any = field(default=None, repr=False)
+
+    def locate(self, y: float, z: float) -> tuple[int, np.ndarray] | None:
+        """The triangle holding the point (y, z) and the point's area coordinates there; None outside the section."""
+        corners = self.nodes[self.elements[:, :3]]  # (n_el, 3, 2)
+        a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+        det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
+        e2 = ((y - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (z - a[:, 1])) / det
+        e3 = ((b[:, 0] - a[:, 0]) * (z - a[:, 1]) - (y - a[:, 0]) * (b[:, 1] - a[:, 1])) / det
+        eta = np.stack([1.0 - e2 - e3, e2, e3], axis=1)
+        best = int(np.argmax(eta.min(axis=1)))
+        if not eta[best].min() >= -_INSIDE_TOLERANCE:
+            return None
+        return best, np.clip(eta[best], 0.0, 1.0)
+
+    def contains(self, y: float, z: float) -> bool:
+        """Whether (y, z), m, lies in the section (its boundary included)."""
+        return self.locate(y, z) is not None
+
+    def interpolate(self, values: np.ndarray, y: float, z: float) -> np.ndarray:
+        """Nodal ``values`` (n, ...) interpolated at (y, z) with the quadratic triangles' shape functions.
+
+        Raises:
+            ConfigError: the point lies outside the section.
+        """
+        found = self.locate(y, z)
+        if found is None:
+            y_min, z_min = self.nodes.min(axis=0)
+            y_max, z_max = self.nodes.max(axis=0)
+            raise ConfigError(f"the point (y, z) = ({y:g}, {z:g}) m is not inside the section (which spans "
+                              f"{y_min:g} <= y <= {y_max:g}, {z_min:g} <= z <= {z_max:g} m)")
+        e, (e1, e2, e3) = found
+        n = np.array([e1 * (2 * e1 - 1), e2 * (2 * e2 - 1), e3 * (2 * e3 - 1), 4 * e1 * e2, 4 * e2 * e3, 4 * e3 * e1])
+        return np.tensordot(n, values[self.elements[e]], axes=1)
+
+    def omega_at(self, y: float, z: float) -> float:
+        """The principal sectorial coordinate at (y, z), m^2."""
+        return float(self.interpolate(self.omega, y, z))
+
+    @cached_property
+    def unit_shear(self) -> np.ndarray:
+        """(n, 3, 2): shear stresses (tau_xy, tau_xz) at the nodes, Pa, per unit St Venant torque (N m) and per
+        unit shear force along y and along z (N): sectionproperties' Saint-Venant and flexure solutions."""
+        stress = self.solved.calculate_stress(vx=1.0, vy=1.0, mzz=1.0).get_stress()[0]
+        # sectionproperties' (x, y, z) are our (y, z, x): its sig_zx is our tau_xy, its sig_zy our tau_xz.
+        out = np.empty((len(self.nodes), 3, 2))
+        for k, load in enumerate(("mzz", "vx", "vy")):
+            out[:, k, 0] = stress[f"sig_zx_{load}"]
+            out[:, k, 1] = stress[f"sig_zy_{load}"]
+        return out
+
+    def shear_at(self, y: float, z: float) -> np.ndarray:
+        """(3, 2): (tau_xy, tau_xz) at (y, z), Pa, per unit St Venant torque, unit V_y and unit V_z."""
+        return np.asarray(self.interpolate(self.unit_shear, y, z))
 
 
 # ---------------------------------------------------------------------------
@@ -359,6 +446,7 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
     a_sx, a_sy = (float(v) for v in section.get_eas())
     i_w = max(gamma, 0.0)
     i_ws = _warping_shear_constant(section, (xs, ys), i_w, ixx + iyy + area * (xs**2 + ys**2))
+    stress_field = _section_field(section, (xs, ys))
     y_min, _, y_max, _ = polygon.bounds
     return SectionProperties(
         A=area,
@@ -380,7 +468,35 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
             f"<= {mesh_size:.3g} m^2, nu = {nu:g})"
         ),
         I_ws=i_ws,
+        stress_field=stress_field,
     )
+
+
+def _section_field(section: Any, pole: tuple[float, float]) -> SectionField:
+    """The mesh and the principal sectorial coordinate about the pole P (relative to C) at its nodes.
+
+    sectionproperties' Saint-Venant warping function ``Phi_C`` (twist about C,
+    ``u_x = theta' Phi``) moves to P as ``Phi_P = Phi_C - z_P y + y_P z``
+    (docs/theory.md §12.1); the sectorial coordinate of (1.2) is ``-Phi_P`` less
+    its mean (the mean weighted by the area: ``integral N_i dA`` per node).
+    """
+    from sectionproperties.analysis.fea import gauss_points
+
+    cy, cz = (float(v) for v in section.get_c())
+    coords = np.array([el.coords for el in section.elements], dtype=float)  # (n_el, 2, 6)
+    ids = np.array([el.node_ids for el in section.elements], dtype=np.int64)
+    nodes = np.zeros((section.num_nodes, 2))
+    nodes[ids, 0], nodes[ids, 1] = coords[:, 0, :], coords[:, 1, :]
+    y, z = nodes[:, 0] - cy, nodes[:, 1] - cz
+    phi = np.asarray(section.section_props.omega, dtype=float) - pole[1] * y + pole[0] * z
+    weights = np.zeros(len(nodes))
+    for gp in gauss_points(n=6):
+        n, _, jac = _tri6_gradients(coords - np.array([cy, cz])[None, :, None], gp[1:])
+        np.add.at(weights, ids, gp[0] * jac[:, None] * n[None, :])
+    omega = -(phi - (weights @ phi) / weights.sum())
+    for array in (nodes, ids, omega):
+        array.setflags(write=False)
+    return SectionField(nodes=nodes, elements=ids, omega=omega, solved=section)
 
 
 #: Below this share of I_ps^2 / A the warping constant is round-off (a section without warping): I_ws is infinite.

@@ -376,8 +376,11 @@ class FrameTraffic:
         A = acc[r_of]
         present = seen[1:][r_of]
         on = present & on_deck(X, self.length)
-        keep = np.flatnonzero(on.any(axis=0))
         ids = list(index)
+        wanted = on.any(axis=0)
+        if any(getattr(self.models[type_of[c]], "contacts", 1) > 1 for c in np.flatnonzero(wanted).tolist()):
+            wanted = self._whole_vehicles(ids, wanted)
+        keep = np.flatnonzero(wanted)
         X = np.where(present, X, -1e6)[:, keep]  # absent: far before the deck
         V = np.where(present, V, 0.0)[:, keep]
         A = np.where(present, A, 0.0)[:, keep]
@@ -389,3 +392,11 @@ class FrameTraffic:
             tuple(ids[c] for c in keep.tolist()), tuple(self.models[type_of[c]] for c in keep.tolist()),
             np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y,
         )
+
+    @staticmethod
+    def _whole_vehicles(ids: list[str], wanted: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
+        """All axle columns (``veh#k``) of a vehicle when any of them is wanted: one body on several contacts
+        loads the deck through all its axles, those still on the approach included (on rigid ground)."""
+        owners = [vehicle_of(i) for i in ids]
+        chosen = {o for o, w in zip(owners, wanted.tolist()) if w}
+        return np.array([o in chosen for o in owners], dtype=bool)

@@ -21,8 +21,13 @@ from typing import Any
 
 from .schemas import (
     EVENTS_SCHEMA,
+    FRAME_TRANSFORM_SCHEMA,
+    SCENE_UPDATE_SCHEMA,
     STATUS_SCHEMA,
     TOPIC_EVENTS,
+    TOPIC_SCENE,
+    TOPIC_SCENE_STATIC,
+    TOPIC_SCENE_TRANSFORM,
     TOPIC_SENSORS,
     TOPIC_STATUS,
     TOPIC_TRAFFIC,
@@ -166,6 +171,9 @@ _COMPILED: dict[str, Callable[..., str | None]] = {
     TOPIC_STATUS: compile_schema(STATUS_SCHEMA),
     TOPIC_TRAFFIC: compile_schema(TRAFFIC_SCHEMA),
     TOPIC_VEHICLE_TYPES: compile_schema(VEHICLE_TYPE_SCHEMA),
+    TOPIC_SCENE: compile_schema(SCENE_UPDATE_SCHEMA),
+    TOPIC_SCENE_STATIC: compile_schema(SCENE_UPDATE_SCHEMA),
+    TOPIC_SCENE_TRANSFORM: compile_schema(FRAME_TRANSFORM_SCHEMA),
 }
 
 

@@ -11,7 +11,8 @@ types follow that list.
 """
 from __future__ import annotations
 
-from typing import Any, Iterable
+from collections.abc import Iterable
+from typing import Any
 
 from cosim.core.fields import VEHICLE_FIELDS
 
@@ -26,6 +27,12 @@ TOPIC_EVENTS = "/cosim/events"
 TOPIC_STATUS = "/cosim/status"
 TOPIC_TRAFFIC = "/cosim/traffic"
 TOPIC_VEHICLE_TYPES = "/cosim/vehicle_types"
+#: The 3D scene (Foxglove's own schemas): the deck, its vehicles and sensors at the scene rate ...
+TOPIC_SCENE = "/cosim/scene"
+#: ... what does not move (the deck at rest, the approaches, the sensors' names), once at t = 0 ...
+TOPIC_SCENE_STATIC = "/cosim/scene/static"
+#: ... and the frame the scene is drawn in (bridge axes) placed in the viewer's world, once at t = 0.
+TOPIC_SCENE_TRANSFORM = "/cosim/scene/transform"
 
 STATUS_STATES = ("started", "running", "finished", "interrupted", "error")
 EVENT_KINDS = ("entered", "left", "liftoff", "touchdown")
@@ -36,6 +43,12 @@ METADATA_NAME = "cosim"
 REPLAY_METADATA_NAME = "replay"
 #: The attachment holding the scenario's TOML text exactly as it was read.
 SCENARIO_ATTACHMENT = "scenario.toml"
+#: The attachment holding the Foxglove layout made for the run (:mod:`cosim.log.layout`).
+LAYOUT_ATTACHMENT = "foxglove_layout.json"
+#: The scene's frames: entities are drawn in ``bridge`` (cosim's axes: x from the first support, y left, z up);
+#: ``world`` has its origin at the middle of the bridge, where a 3D viewer's camera looks first.
+SCENE_FRAME = "bridge"
+WORLD_FRAME = "world"
 
 _NUMBER = {"type": "number"}
 
@@ -70,14 +83,14 @@ VEHICLES_SCHEMA = {
 }
 EVENTS_SCHEMA = {
     "title": "cosim.TrafficEvent", "type": "object",
-    "properties": {"t": _NUMBER, "vehicle": {"type": "string"}, "event": {"enum": list(EVENT_KINDS)},
+    "properties": {"t": _NUMBER, "vehicle": {"type": "string"}, "event": {"type": "string", "enum": list(EVENT_KINDS)},
                    "x": _NUMBER},
     "required": ["t", "vehicle", "event"], "additionalProperties": False,
 }
 STATUS_SCHEMA = {
     "title": "cosim.RunStatus", "type": "object",
-    "properties": {"t": _NUMBER, "state": {"enum": list(STATUS_STATES)}, "message": {"type": "string"},
-                   "progress": _NUMBER, "wall_time": _NUMBER},
+    "properties": {"t": _NUMBER, "state": {"type": "string", "enum": list(STATUS_STATES)},
+                   "message": {"type": "string"}, "progress": _NUMBER, "wall_time": _NUMBER},
     "required": ["t", "state"], "additionalProperties": False,
 }
 TRAFFIC_SCHEMA = {
@@ -104,9 +117,76 @@ VEHICLE_TYPE_SCHEMA = {
 }
 
 
-def topic_schemas(sensor_names: Iterable[str]) -> list[tuple[str, dict[str, Any]]]:
-    """Every topic of a log with its schema (whose ``title`` names it), in the order the channels are registered."""
-    return [
+
+# --------------------------------------------------------------------------- Foxglove's schemas (the 3D scene)
+#
+# The scene topics use Foxglove's own message schemas, so that its 3D panel draws them: the names and
+# fields of foxglove.SceneUpdate and foxglove.FrameTransform (their JSON Schemas: github.com/foxglove/
+# foxglove-sdk, schemas/jsonschema/), JSON encoding. Written here as the subset cosim writes (the primitives
+# it draws), with a "type" on every property as Foxglove's JSON-Schema parser needs (enumerations as
+# integers), and stricter than Foxglove's (no other fields) because the reader checks every message.
+
+
+def _fox(title: str, properties: dict[str, Any], description: str = "") -> dict[str, Any]:
+    out: dict[str, Any] = {"title": title, "type": "object"}
+    if description:
+        out["description"] = description
+    out["properties"] = properties
+    out["additionalProperties"] = False
+    return out
+
+
+def _array(items: dict[str, Any]) -> dict[str, Any]:
+    return {"type": "array", "items": items}
+
+
+_INTEGER = {"type": "integer"}
+_BOOLEAN = {"type": "boolean"}
+_STRING = {"type": "string"}
+_TIME = _fox("time", {"sec": _INTEGER, "nsec": _INTEGER}, "seconds and nanoseconds (simulated time)")
+_DURATION = _fox("duration", {"sec": _INTEGER, "nsec": _INTEGER})
+_VECTOR3 = _fox("foxglove.Vector3", {"x": _NUMBER, "y": _NUMBER, "z": _NUMBER})
+_QUATERNION = _fox("foxglove.Quaternion", {"x": _NUMBER, "y": _NUMBER, "z": _NUMBER, "w": _NUMBER})
+_POSE = _fox("foxglove.Pose", {"position": _VECTOR3, "orientation": _QUATERNION})
+_COLOR = _fox("foxglove.Color", {"r": _NUMBER, "g": _NUMBER, "b": _NUMBER, "a": _NUMBER}, "RGBA, each 0 to 1")
+_PRIMITIVES: dict[str, dict[str, Any]] = {
+    "arrows": _fox("foxglove.ArrowPrimitive", {
+        "pose": _POSE, "shaft_length": _NUMBER, "shaft_diameter": _NUMBER, "head_length": _NUMBER,
+        "head_diameter": _NUMBER, "color": _COLOR}, "an arrow along the +x axis of its pose, tail at the position"),
+    "cubes": _fox("foxglove.CubePrimitive", {"pose": _POSE, "size": _VECTOR3, "color": _COLOR}),
+    "spheres": _fox("foxglove.SpherePrimitive", {"pose": _POSE, "size": _VECTOR3, "color": _COLOR}),
+    "cylinders": _fox("foxglove.CylinderPrimitive", {
+        "pose": _POSE, "size": _VECTOR3, "bottom_scale": _NUMBER, "top_scale": _NUMBER, "color": _COLOR}),
+    "lines": _fox("foxglove.LinePrimitive", {
+        "type": {"type": "integer", "description": "0 LINE_STRIP, 1 LINE_LOOP, 2 LINE_LIST"},
+        "pose": _POSE, "thickness": _NUMBER, "scale_invariant": _BOOLEAN, "points": _array(_VECTOR3),
+        "color": _COLOR, "colors": _array(_COLOR), "indices": _array(_INTEGER)}),
+    "triangles": _fox("foxglove.TriangleListPrimitive", {
+        "pose": _POSE, "points": _array(_VECTOR3), "color": _COLOR, "colors": _array(_COLOR),
+        "indices": _array(_INTEGER)}),
+    "texts": _fox("foxglove.TextPrimitive", {
+        "pose": _POSE, "billboard": _BOOLEAN, "font_size": _NUMBER, "scale_invariant": _BOOLEAN, "color": _COLOR,
+        "text": _STRING}),
+}
+_SCENE_ENTITY = _fox("foxglove.SceneEntity", {
+    "timestamp": _TIME, "frame_id": _STRING, "id": _STRING, "lifetime": _DURATION, "frame_locked": _BOOLEAN,
+    "metadata": _array(_fox("foxglove.KeyValuePair", {"key": _STRING, "value": _STRING})),
+    **{name: _array(item) for name, item in _PRIMITIVES.items()},
+}, "a visual element of the scene; an entity replaces the earlier one of the same id on its topic")
+_SCENE_DELETION = _fox("foxglove.SceneEntityDeletion", {
+    "timestamp": _TIME, "type": {"type": "integer", "description": "0 MATCHING_ID, 1 ALL"}, "id": _STRING})
+SCENE_UPDATE_SCHEMA = _fox("foxglove.SceneUpdate", {
+    "deletions": _array(_SCENE_DELETION), "entities": _array(_SCENE_ENTITY)},
+    "an update to the entities displayed in a 3D scene")
+FRAME_TRANSFORM_SCHEMA = _fox("foxglove.FrameTransform", {
+    "timestamp": _TIME, "parent_frame_id": _STRING, "child_frame_id": _STRING, "translation": _VECTOR3,
+    "rotation": _QUATERNION}, "the child frame's origin and orientation in the parent frame")
+
+
+def topic_schemas(sensor_names: Iterable[str], scene: bool = False) -> list[tuple[str, dict[str, Any]]]:
+    """Every topic of a log with its schema (whose ``title`` names it), in the order the channels are registered;
+    with ``scene``, the 3D scene's topics too."""
+    topics = [
         (TOPIC_SENSORS, sensors_schema(sensor_names)),
         (TOPIC_VEHICLES, VEHICLES_SCHEMA),
         (TOPIC_EVENTS, EVENTS_SCHEMA),
@@ -114,6 +194,10 @@ def topic_schemas(sensor_names: Iterable[str]) -> list[tuple[str, dict[str, Any]
         (TOPIC_TRAFFIC, TRAFFIC_SCHEMA),
         (TOPIC_VEHICLE_TYPES, VEHICLE_TYPE_SCHEMA),
     ]
+    if scene:
+        topics += [(TOPIC_SCENE, SCENE_UPDATE_SCHEMA), (TOPIC_SCENE_STATIC, SCENE_UPDATE_SCHEMA),
+                   (TOPIC_SCENE_TRANSFORM, FRAME_TRANSFORM_SCHEMA)]
+    return topics
 
 
 def to_ns(t: float) -> int:

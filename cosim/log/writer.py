@@ -21,8 +21,9 @@ import struct
 import threading
 import time
 import traceback
+from collections.abc import Iterable
 from pathlib import Path
-from typing import IO, Any, Iterable
+from typing import IO, Any
 
 import numpy as np
 import orjson
@@ -152,10 +153,11 @@ class LogRecorder:
         sensor_names: the sensor channels, in order.
         force: overwrite an existing file (otherwise refuse).
         chunk_size: bytes per chunk; small chunks lose little when the process is killed.
+        scene: also register the 3D scene's topics (:mod:`cosim.log.scene`).
     """
 
     def __init__(self, path: str | Path, sensor_names: Iterable[str], force: bool = False,
-                 chunk_size: int = 256 * 1024) -> None:
+                 chunk_size: int = 256 * 1024, scene: bool = False) -> None:
         self.path = Path(path)
         if self.path.exists() and not force:
             raise LogError(f"{self.path}: exists; refusing to overwrite a log (use --force)")
@@ -173,9 +175,12 @@ class LogRecorder:
         self._sequence = 0
         self._closed = False
         self.final_state: str | None = None
-        for topic, schema in topic_schemas(self.sensor_names):
-            sid = self._writer.register_schema(schema["title"], "jsonschema", json.dumps(schema).encode())
-            self._channels[topic] = self._writer.register_channel(topic, "json", sid)
+        schema_ids: dict[bytes, int] = {}
+        for topic, schema in topic_schemas(self.sensor_names, scene=scene):
+            text = json.dumps(schema).encode()
+            if text not in schema_ids:  # one schema record for the topics that share it
+                schema_ids[text] = self._writer.register_schema(schema["title"], "jsonschema", text)
+            self._channels[topic] = self._writer.register_channel(topic, "json", schema_ids[text])
         self._last_t = 0.0
         # The block logger's thread and the traffic source (main thread) both write.
         self._lock = threading.Lock()
@@ -243,7 +248,7 @@ class LogRecorder:
                 self._writer.finish()
                 self._stream.close()
 
-    def __enter__(self) -> "LogRecorder":
+    def __enter__(self) -> LogRecorder:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -294,17 +299,23 @@ class BlockLogger:
     compiled solver computes the next block, so logging costs little wall
     time on a machine with a spare core; the queue holds a few blocks at most.
     Use as a context manager (or call :meth:`close`) so the thread drains.
+
+    The first ``len(sensor_names)`` sensor columns of a block are logged; columns after them (the
+    scene's, :mod:`cosim.log.scene`) go only to ``scene`` (an object with ``write_block(times, report)``),
+    which draws the 3D scene in the same thread.
     """
 
     def __init__(self, recorder: LogRecorder, sensor_names: Iterable[str], total_time: float,
-                 status_every: float = 10.0, threaded: bool = True) -> None:
+                 status_every: float = 10.0, threaded: bool = True, scene: Any = None) -> None:
         self.rec = recorder
         self.names = list(sensor_names)
+        self.scene = scene
         self.total_time = total_time
         self.status_every = status_every
         self._next_status = status_every
         self._on: dict[str, bool] = {}
         self._lifted: dict[str, bool] = {}
+        self._last_x: dict[str, float] = {}  # vehicles on the deck at the end of the last block: their x
         self._model_names: dict[str, str] = {}
         self._sensor_template = (b'{"t":%s' + b"".join(b"," + _template_part(n) + b":%s" for n in self.names) + b"}")
         self._vehicle_templates: dict[tuple[str, ...], bytes] = {}
@@ -326,7 +337,7 @@ class BlockLogger:
         else:
             self._queue.put((times, keep, report))
 
-    def paced(self, traffic: Any) -> "_PacedTraffic":
+    def paced(self, traffic: Any) -> _PacedTraffic:
         """``traffic``, wrapped so that the writer thread knows when the solver starts its next block.
 
         Pass the wrapper to :func:`cosim.core.simulation.simulate` instead of
@@ -373,7 +384,7 @@ class BlockLogger:
             raise LogError(f"{self.rec.path}: writing the log failed: {self._error!r}"
                            + (f" ({where[-3].strip()})" if len(where) >= 3 else ""))
 
-    def __enter__(self) -> "BlockLogger":
+    def __enter__(self) -> BlockLogger:
         return self
 
     def __exit__(self, exc_type, exc, tb) -> None:
@@ -388,8 +399,8 @@ class BlockLogger:
         kept = np.flatnonzero(keep)
         if len(kept):
             t = times[kept]
-            tokens = _number_tokens(np.column_stack([t, report.sensors[kept]]))
             width = 1 + len(self.names)
+            tokens = _number_tokens(np.column_stack([t, report.sensors[kept, :width - 1]]))
             template = self._sensor_template
             rec.write_encoded(TOPIC_SENSORS, t.tolist(),
                               [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)])
@@ -397,17 +408,21 @@ class BlockLogger:
         if report.ids:
             self._events(times, report)
             self._vehicles(times, kept, report)
+        if self.scene is not None:
+            self.scene.write_block(times, report)
         if times[-1] >= self._next_status:
             rec.status(float(times[-1]), "running", progress=float(times[-1] / self.total_time))
             rec.flush()
             self._next_status += self.status_every
 
     def _gone(self, times, report) -> None:
-        """Vehicles on the deck at the end of the last block that the traffic no longer has: they left."""
+        """Vehicles on the deck at the end of the last block that the traffic no longer has: they left
+        (arrived or removed on the deck); the event carries where they were last."""
         present = set(report.ids)
         for vid in [v for v, on in self._on.items() if on and v not in present]:
             t = float(times[0])
-            self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left"})
+            self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left",
+                                             "x": self._last_x.pop(vid, 0.0)})
             self._on[vid] = self._lifted[vid] = False
 
     def _events(self, times, report) -> None:
@@ -421,10 +436,18 @@ class BlockLogger:
             changed = np.diff(np.vstack([prev[None, :], state]).astype(np.int8), axis=0) != 0
             for k, j in zip(*np.nonzero(changed)):
                 t = float(times[k])
+                if state[k, j] or names[0] != "left":
+                    x = float(report.x[k, j])
+                else:  # left: where it was last on the deck (a vehicle that vanished has no position after)
+                    x = float(report.x[k - 1, j]) if k > 0 else self._last_x.get(ids[j], float(report.x[k, j]))
                 self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": names[int(state[k, j])],
-                                                 "x": float(report.x[k, j])})
+                                                 "x": x})
         for j, vid in enumerate(ids):
             self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
+            if on[-1, j]:
+                self._last_x[vid] = float(report.x[-1, j])
+            else:
+                self._last_x.pop(vid, None)
 
     def _vehicle_item(self, vid: str) -> bytes:
         """``{"id":..,"model":..,"x":%s,...}``: one vehicle's item, its fields in :data:`VEHICLE_FIELDS` order."""
@@ -489,6 +512,10 @@ class TrafficLogger:
     def __init__(self, recorder: LogRecorder) -> None:
         self.rec = recorder
         self._types: set[str] = set()
+
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""
+        self.rec.attach(name, data, media_type)
 
     def __call__(self, frame, models: dict) -> None:
         for typ in frame.types:

@@ -10,6 +10,7 @@ log afterwards: :mod:`cosim.run.replay`, :mod:`cosim.run.export`,
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import datetime
 import json
 import os
@@ -17,19 +18,24 @@ import platform
 import secrets
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cosim import __version__
+from cosim.analysis.fatigue import FatigueResult
 from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
 from cosim.core.limits import MAX_STEPS
 from cosim.core.simulation import SimulationResult, simulate
+from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
+from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
+from cosim.log.scene import ScenePlan, SceneWriter, plan_scene, scene_sensors, scene_wanted
 from cosim.log.schemas import (
+    LAYOUT_ATTACHMENT,
     METADATA_NAME,
     REPLAY_METADATA_NAME,
     SCENARIO_ATTACHMENT,
@@ -37,13 +43,16 @@ from cosim.log.schemas import (
 )
 from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
 
+from .engineering import FatigueRecorder, fatigue_payload, stress_curves
 from .inputs import input_files
 from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
-from .simulate import SOLVER_FAILURES, build_traffic, likely_cause
+from .simulate import SOLVER_FAILURES, build_traffic, likely_cause, plan_sumo
 
+#: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
+FATIGUE_METADATA_NAME = "fatigue"
 #: Modes whose frequencies and kinds are stored in the log (``modes.json``).
 LOGGED_MODES = 20
 #: How often a "running" status is logged, s of simulated time.
@@ -75,6 +84,8 @@ class RunOutcome:
         samples: sensor samples in the log (t = 0 included).
         wall_time: wall time of the whole logged run, s (time stepping and logging).
         log_bytes: size of the finished log.
+        fatigue: sensor name -> rainflow count and Miner damage of its logged samples (stress sensors with an
+            S-N curve; the damage per year for the run's traffic all year).
     """
 
     scenario: Scenario
@@ -87,6 +98,7 @@ class RunOutcome:
     samples: int
     wall_time: float
     log_bytes: int
+    fatigue: dict[str, FatigueResult] = field(default_factory=dict)
 
 
 class _DeckTimes:
@@ -150,6 +162,45 @@ class _StartsOnFirstBlock:
         return getattr(self.traffic, name)
 
 
+def _contact_ids(traffic: Any) -> list[str] | None:
+    """The contact points of scripted vehicles (``id``, or ``id#k`` per axle), known before the run; else None."""
+    if not isinstance(traffic, ScriptedTraffic):
+        return None
+    ids: list[str] = []
+    for vehicle in traffic.vehicles:
+        axles = len(vehicle.model.contact_offsets)
+        ids += [f"{vehicle.id}{AXLE_SEPARATOR}{k}" for k in range(axles)] if axles > 1 else [vehicle.id]
+    return ids
+
+
+def _scene_plan(scenario: Scenario, bridge: BridgeModel, sensors: list, solver: Any, duration: float,
+                traffic: Any, by_default: bool = True) -> ScenePlan | None:
+    """The run's 3D scene (``[output].scene``; unset: on for runs of at most an hour unless not
+    ``by_default``), or None."""
+    setting = scenario.output.scene
+    if setting is None and not by_default:
+        return None
+    if not scene_wanted(setting, duration):
+        return None
+    exaggeration = None if setting is None or isinstance(setting, bool) else float(setting)
+    weight = contact = None
+    paths: list[float] = []
+    if isinstance(traffic, ScriptedTraffic) and traffic.vehicles:  # the heaviest is known: the scales follow it
+        g = solver.gravity
+        weight = max(v.model.total_mass for v in traffic.vehicles) * g or None
+        contact = max(v.model.total_mass / v.model.contacts for v in traffic.vehicles) * g or None
+        paths = [v.y for v in traffic.vehicles]
+    return plan_scene(bridge, sensors, solver.dt, exaggeration=exaggeration, reference_weight=weight,
+                      reference_contact=contact, paths=paths, taken=[s.name for s in sensors])
+
+
+def _named_only(result: SimulationResult, names: list[str]) -> SimulationResult:
+    """The result without the scene's hidden sensors."""
+    return dataclasses.replace(
+        result, sensors={n: result.sensors[n] for n in names},
+        sensor_min={n: result.sensor_min[n] for n in names}, sensor_max={n: result.sensor_max[n] for n in names})
+
+
 def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: float, given: bool,
                 modal: Any) -> None:
     """Bounds that the run itself would only hit after its log exists: time steps, the basis."""
@@ -185,6 +236,7 @@ def run_logged(
     started: datetime.datetime | None = None,
     traffic: Any = None,
     duration: float | None = None,
+    scene_by_default: bool = True,
 ) -> RunOutcome:
     """Run ``scenario``'s vehicles over its bridge and stream everything into the MCAP log ``log_path``.
 
@@ -214,6 +266,7 @@ def run_logged(
         started: wall-clock start time for the metadata (default now).
         traffic: a traffic source to use instead of the scenario's (replay of logged SUMO frames).
         duration: simulated time instead of the scenario's, s.
+        scene_by_default: draw the 3D scene when ``[output].scene`` is unset (studies: no).
 
     Raises:
         RunInterrupted: a signal; ``log_path`` is the finished log (status "interrupted"), or None if
@@ -228,6 +281,7 @@ def run_logged(
     if bridge is None:
         bridge = scenario.build_bridge()
     live_sumo = traffic is None and scenario.traffic is not None
+    sumo_plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
     if traffic is None and not live_sumo:
         traffic = scenario.build_vehicles()
     road = scenario.build_road()
@@ -240,6 +294,8 @@ def run_logged(
     names = [s.name for s in sensors]
     modal = bridge.modes(count=LOGGED_MODES)
     _check_size(scenario, bridge, solver, duration, given, modal)
+    plan = _scene_plan(scenario, bridge, sensors, solver, duration, traffic, scene_by_default)
+    contacts = _contact_ids(traffic)
     inputs = input_files(scenario)
     files = {}
     for item in inputs:
@@ -268,7 +324,10 @@ def run_logged(
             "replayed frames" if traffic is not None and not scenario.vehicles else "scripted"),
         "inputs": json.dumps({item.key: item.attachment for item in inputs if item.key}),
         "python": platform.python_version(),
+        **({"contacts": json.dumps(contacts)} if contacts is not None else {}),
+        **(plan.metadata() if plan is not None else {}),
     }
+    layout = make_layout(inputs_from_metadata(meta, names, [s.quantity for s in sensors], str(log_path)))
     resolved = {
         "scenario": scenario.model_dump(mode="json", by_alias=True, warnings=False),
         "derived": {"duration": duration, "output_every": every, "rate_hz": rate_hz,
@@ -280,27 +339,29 @@ def run_logged(
         "section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
         "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
                                  indent=1).encode(),
+        LAYOUT_ATTACHMENT: layout_bytes(layout),
     }
     with stop_signals() as guard, contextlib.ExitStack() as sumo:
         try:
             if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
-                traffic = sumo.enter_context(build_traffic(scenario))
+                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan))
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
         return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
-                       duration, every, rate_hz, meta, replay, documents, progress)
+                       duration, every, rate_hz, meta, replay, documents, progress, plan)
 
 
 def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,
             live_sumo: bool, road: Any, solver: Any, sensors: list, duration: float, every: int, rate_hz: float,
             meta: dict[str, str], replay: dict[str, str] | None, documents: dict[str, bytes],
-            progress: Callable[[float], None] | None) -> RunOutcome:
+            progress: Callable[[float], None] | None, plan: ScenePlan | None) -> RunOutcome:
     """The log itself: written under a temporary name until the stepping starts, then as ``log_path``."""
     names = [s.name for s in sensors]
     partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
     extremes = _DeckTimes()
     samples = _Samples()
+    fatigue = FatigueRecorder(names, stress_curves(scenario))
     wall_start = time.perf_counter()
     state = {"started": False}
 
@@ -322,9 +383,16 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         with contextlib.suppress(OSError):
             partial.unlink()
 
+    def sumo_said() -> None:
+        # SUMO is closed before the log is finished, so that all it said goes into the log (the adapter
+        # attaches its messages through its frame sink when it closes).
+        if live_sumo and rec is not None:
+            with contextlib.suppress(Exception):
+                traffic.close()
+
     try:
         try:
-            rec = LogRecorder(partial, names, force=False)
+            rec = LogRecorder(partial, names, force=False, scene=plan is not None)
         except LogError as exc:  # name the log the user asked for, not its temporary name
             raise LogError(str(exc).replace(str(partial), str(log_path))) from None
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
@@ -338,12 +406,17 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         rec.status(0.0, "started", f"{scenario.title}: {duration:g} s simulated, dt = {solver.dt:g} s, "
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
-        with BlockLogger(rec, names, duration, status_every=STATUS_EVERY) as logger:
+        scene = SceneWriter(rec, plan, len(names)) if plan is not None else None
+        if scene is not None:
+            scene.start()
+        with BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene) as logger:
             if live_sumo:
                 traffic.frame_sink = TrafficLogger(rec)
+                traffic.log_documents(rec.attach)
             result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
-                              sensors=sensors, road=road, output_every=every, progress=progress,
-                              observers=[extremes, samples, logger], collect=False)
+                              sensors=[*sensors, *(scene_sensors(plan) if plan is not None else [])], road=road,
+                              output_every=every, progress=progress, observers=[extremes, samples, fatigue, logger],
+                              collect=False)
             guard.closing = True  # a signal from here on must not cut the log's ending short
     except KeyboardInterrupt as exc:
         guard.closing = True
@@ -351,6 +424,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         if not state["started"] or rec is None:
             discard()
             raise RunInterrupted(signum, name, None) from None
+        sumo_said()
         rec.close("interrupted", interruption_message(exc), wall_time=time.perf_counter() - wall_start)
         raise RunInterrupted(signum, name, log_path) from None
     except (CosimError, *SOLVER_FAILURES) as exc:
@@ -366,6 +440,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             text = str(exc) if isinstance(exc, ModelError) else \
                 f"the solution diverged: the solver met non-finite values ({type(exc).__name__}: {exc})"
             message = f"{text}; likely cause: {likely_cause(scenario, road, solver)}"
+        sumo_said()
         try:
             rec.close("error", message, wall_time=time.perf_counter() - wall_start)
         except (OSError, ValueError, LogError):
@@ -379,10 +454,17 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             with contextlib.suppress(Exception):
                 rec.close("error", f"{type(exc).__name__}: {exc}", wall_time=time.perf_counter() - wall_start)
         raise
+    damage = fatigue.results(duration, len(result.vehicle_ids))
+    if damage:
+        payload = fatigue_payload(damage)
+        rec.metadata(FATIGUE_METADATA_NAME, {k: json.dumps(jsonable(v)) for k, v in payload.items()})
+    sumo_said()
     wall = time.perf_counter() - wall_start
     rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
+    if plan is not None:
+        result = _named_only(result, names)
     return RunOutcome(
         scenario=scenario, log_path=log_path, result=result, duration=duration, every=every, rate_hz=rate_hz,
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,
-        wall_time=wall, log_bytes=log_path.stat().st_size,
+        wall_time=wall, log_bytes=log_path.stat().st_size, fatigue=damage,
     )

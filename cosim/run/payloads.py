@@ -6,7 +6,7 @@ The same payloads go into a log (``section.json``, ``modes.json``), the
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
+from dataclasses import fields
 from typing import Any
 
 from cosim.core.bridge import BridgeModel, ModalResult
@@ -34,8 +34,8 @@ def jsonable(value: Any) -> Any:
 
 
 def section_payload(section: SectionProperties) -> dict[str, Any]:
-    """Every section constant by name (SI units)."""
-    return jsonable(asdict(section))
+    """Every section constant by name (SI units); not the FE mesh and fields of a section of plates."""
+    return jsonable({f.name: getattr(section, f.name) for f in fields(section) if f.name != "stress_field"})
 
 
 def modes_payload(modal: ModalResult, shapes: bool = False) -> list[dict[str, Any]]:

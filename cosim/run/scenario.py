@@ -224,7 +224,7 @@ class Scenario(ConfigModel):
                 problems.append(
                     (("sensors", i, "x"), f"must lie on the bridge, 0 <= x <= {length:g} m (got {show(sensor.x)})")
                 )
-            if not y_min - tol_y <= sensor.y <= y_max + tol_y:
+            if sensor.z is None and not y_min - tol_y <= sensor.y <= y_max + tol_y:  # (y, z): checked in the section
                 problems.append(
                     (("sensors", i, "y"),
                      f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {show(sensor.y)})")
@@ -506,7 +506,7 @@ class Scenario(ConfigModel):
 
     def sensors_core(self) -> list[Sensor]:
         """The ``[[sensors]]`` as :class:`cosim.core.simulation.Sensor` objects."""
-        return [Sensor(name=s.name, x=s.x, y=s.y, quantity=s.quantity) for s in self.sensors]
+        return [s.to_sensor() for s in self.sensors]
 
     @contextlib.contextmanager
     def named(self, key: str) -> Iterator[None]:

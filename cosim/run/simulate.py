@@ -9,20 +9,26 @@ core objects; what starts processes and runs lives here::
     scenario = load_scenario("paper-double-tee")
     result = simulate_scenario(scenario)            # cosim.core.simulation.SimulationResult
 
-Runs with a log: :func:`cosim.run.logged.run_logged`.
+Runs with a log: :func:`cosim.run.logged.run_logged`. Before a SUMO run
+starts (and before its log is created), :func:`plan_sumo` reads the network
+and the demand files: it places the bridge (the axis given, or derived from
+``[traffic] edges``), checks that the lanes fit the deck, and turns every
+vType into its vehicle model, so that a wrong edge or vType is an error
+before anything is written.
 """
 from __future__ import annotations
 
 import contextlib
-import math
 from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cosim.core.bridge import BridgeModel
 from cosim.core.simulation import SimulationResult, simulate
-from cosim.errors import ConfigError, ModelError
+from cosim.errors import ConfigError, ModelError, SumoError
 
 from .scenario import Scenario
 
@@ -38,7 +44,9 @@ def likely_cause(scenario: Scenario, road: Any, solver: Any) -> str:
     """The likeliest reason a run diverged, from its inputs: a parameter out of range, else the step."""
     for i, vehicle in enumerate(scenario.vehicles):
         for key, value in vehicle.parameters.items():
-            low, high = _PLAUSIBLE.get(key, (-math.inf, math.inf))
+            if key not in _PLAUSIBLE:  # a half-car's axles and pitch switch: checked by the model
+                continue
+            low, high = _PLAUSIBLE[key]
             if not low <= value <= high:
                 return (f"vehicles[{i}] ({vehicle.id}): {key} = {value:g} is outside any road vehicle's range "
                         f"({low:g} to {high:g})")
@@ -49,29 +57,118 @@ def likely_cause(scenario: Scenario, road: Any, solver: Any) -> str:
             f"(solver.dt = {solver.dt:g} s; try a smaller dt, or the modal basis with fewer modes)")
 
 
-def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = None) -> Any:
+#: The carriageway may overhang the deck's edges by this much, m (round-off of lane geometry).
+DECK_FIT_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class SumoPlan:
+    """A SUMO run as it will be, found before SUMO starts.
+
+    Attributes:
+        config: the SUMO config; net: its network.
+        axis: the bridge axis in network coordinates (a :class:`cosim.sumo.network.BridgeAxis`).
+        axis_from: how the axis was found (given, derived from the edges, or the default).
+        location: the bridge located from ``[traffic] edges`` (a :class:`cosim.sumo.network.BridgeLocation`),
+            or None.
+        deck_y: the deck's lateral extent, m.
+        demand: what the demand files hold (:class:`cosim.sumo.files.Demand`).
+        types: every vType's vehicle model (:class:`cosim.sumo.vtypes.VehicleType`), as the files say it;
+            a vType without a ``length`` has its library vehicle's here and SUMO's own in the run.
+    """
+
+    config: Path
+    net: Path
+    axis: Any
+    axis_from: str
+    location: Any
+    deck_y: tuple[float, float]
+    demand: Any
+    types: tuple[Any, ...]
+
+
+def plan_sumo(scenario: Scenario) -> SumoPlan:
+    """Read the network and demand of ``scenario``'s ``[traffic]`` and place the bridge (nothing runs).
+
+    The axis: ``[traffic] axis`` if given; else derived from ``[traffic] edges``
+    (:func:`cosim.sumo.network.locate_bridge`, with the bridge's length); else
+    (0, 0) -> (L, 0). The lanes of the named edges must lie on the deck.
+
+    Raises:
+        ConfigError: naming the scenario and the key: an edge the network lacks, lanes off the deck, a
+            length that does not match, no lane on the axis, a vType with an unknown or impossible param.
+    """
+    from cosim.sumo.files import read_demand
+    from cosim.sumo.network import BridgeAxis, lanes_across, locate_bridge, net_path
+    from cosim.sumo.vtypes import vehicle_type
+
+    t = scenario.traffic
+    if t is None:
+        raise ConfigError(f"{scenario.source}: the scenario has no [traffic]")
+    config = scenario.sumo_config_path
+    assert config is not None
+    length = scenario.bridge.length
+    deck_y = scenario.bridge.section.deck_y
+    with scenario.named("traffic.sumo_config"):
+        demand = read_demand(config)
+        net = net_path(config)
+    location = None
+    with scenario.named("traffic.edges"):
+        if t.edges:
+            location = locate_bridge(net, t.edges, length=length if t.axis is None else None)
+    if t.axis is not None:
+        axis, axis_from = BridgeAxis(*t.axis), "given ([traffic] axis)"
+    elif location is not None:
+        axis, axis_from = location.axis, f"derived from edges {', '.join(t.edges)}"
+        lo, hi = location.carriageway
+        if lo < deck_y[0] - DECK_FIT_TOLERANCE or hi > deck_y[1] + DECK_FIT_TOLERANCE:
+            raise ConfigError(
+                f"{scenario.source}: traffic.edges: the lanes of {', '.join(t.edges)} reach y = {lo:.3f} to "
+                f"{hi:.3f} m from the derived axis; the deck (bridge.section) spans y = {deck_y[0]:g} to "
+                f"{deck_y[1]:g} m: widen the section's deck, or give [traffic] axis")
+    else:
+        axis, axis_from = BridgeAxis((0.0, 0.0), (length, 0.0)), "the default (0, 0) -> (L, 0)"
+    if location is None:
+        with scenario.named("traffic"):
+            if not lanes_across(net, axis, deck_y):
+                raise ConfigError(
+                    f"no lane of {net.name} runs along the bridge axis {axis.start} -> {axis.end} ({axis_from}) "
+                    "within the deck: name the bridge's edges in [traffic] edges (cosim bridge "
+                    f"{config.name} lists candidates), or give axis")
+    types = []
+    for type_id in [v for v in demand.vtypes if v not in demand.distributions] + (
+            ["DEFAULT_VEHTYPE"] if demand.untyped else []):
+        entry = demand.vtypes.get(type_id)
+        vclass = (entry.vclass if entry is not None else None) or "passenger"
+        own_length = entry.length if entry is not None else None
+        try:
+            types.append(vehicle_type(type_id, vclass, own_length, entry.mass if entry is not None else None,
+                                      entry.params if entry is not None else {}))
+        except SumoError as exc:
+            where = f"{entry.file}: " if entry is not None else ""
+            raise ConfigError(f"{scenario.source}: traffic.sumo_config: {where}{exc}") from None
+    return SumoPlan(config=config, net=net, axis=axis, axis_from=axis_from, location=location, deck_y=deck_y,
+                    demand=demand, types=tuple(types))
+
+
+def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = None,
+                  plan: SumoPlan | None = None) -> Any:
     """The scenario's traffic source: :class:`cosim.sumo.adapter.SumoTraffic` (not started) for
     ``[traffic]``, else its scripted vehicles (:meth:`Scenario.build_vehicles`).
 
     Args:
         frame_sink: with SUMO, called with every frame (e.g. to log it).
+        plan: with SUMO, the run's :func:`plan_sumo` if already made.
     """
     if scenario.traffic is None:
         return scenario.build_vehicles()
-    from cosim.sumo.adapter import (  # only SUMO runs load libsumo
-        BridgeAxis,
-        SumoTraffic,
-    )
+    from cosim.sumo.adapter import SumoTraffic  # only SUMO runs load libsumo
 
     t = scenario.traffic
-    length = scenario.bridge.length
-    axis = BridgeAxis(*t.axis) if t.axis is not None else BridgeAxis((0.0, 0.0), (length, 0.0))
-    y_min, y_max = scenario.bridge.section.deck_y
-    path = scenario.sumo_config_path
-    assert path is not None
+    plan = plan or plan_sumo(scenario)
     with scenario.named("traffic"):
-        return SumoTraffic(path, axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
-                           seed=t.seed, half_width=max(abs(y_min), abs(y_max)), frame_sink=frame_sink)
+        return SumoTraffic(plan.config, plan.axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
+                           seed=t.seed, deck_y=plan.deck_y, frame_sink=frame_sink, demand=plan.demand)
 
 
 def simulate_scenario(

@@ -16,7 +16,9 @@ from typing import Annotated, Any
 
 from pydantic import Field, PlainValidator, Strict, model_validator
 
+from cosim.analysis.fatigue import SNCurve, sn_curve, sn_curve_names
 from cosim.core.roughness import ISO_CLASSES
+from cosim.core.sensors import SECTION_POINT_QUANTITIES, SENSOR_QUANTITIES, Sensor
 from cosim.core.simulation import SolverSettings
 from cosim.core.traffic import ScriptedVehicle
 from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
@@ -31,6 +33,7 @@ from .config_base import (
     PositiveInt,
     Problems,
     choice,
+    choices_message,
     describe,
     fail,
     number_problem,
@@ -49,6 +52,7 @@ __all__ = [
     "RoadConfig",
     "SCHEMES",
     "SUMO_LEVELS",
+    "SNCurveConfig",
     "SensorConfig",
     "SolverConfig",
     "TrafficConfig",
@@ -61,8 +65,9 @@ __all__ = [
 
 # --------------------------------------------------------------------------- names
 
-#: Sensor quantities.
-QUANTITIES: tuple[str, ...] = ("displacement", "velocity", "acceleration", "bending_moment")
+#: Sensor quantities (the core's list: displacement, velocity, acceleration, bending_moment, and the stresses and the
+#: strain read at a section point).
+QUANTITIES: tuple[str, ...] = SENSOR_QUANTITIES
 
 SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
@@ -100,13 +105,75 @@ DEFAULT_RATE_HZ = 100.0
 # --------------------------------------------------------------------------- tables
 
 
+class SNCurveConfig(ConfigModel):
+    """``sn_curve = {ds_ref = ..., ...}`` of a stress sensor: a user's S-N curve (Pa, cycles)."""
+
+    ds_ref: Positive
+    n_ref: Positive
+    m1: Positive
+    m2: Positive | None = None
+    n_knee: Positive | None = None
+    n_cutoff: Positive | None = None
+
+    @model_validator(mode="after")
+    def _curve(self) -> SNCurveConfig:
+        try:
+            self.to_curve("check", 1.0)
+        except ConfigError as exc:
+            raise fail(str(exc).split(": ", 1)[-1]) from None
+        return self
+
+    def to_curve(self, name: str, partial_factor: float) -> SNCurve:
+        """The :class:`cosim.analysis.fatigue.SNCurve` (one slope when m2 and n_knee are not given)."""
+        return SNCurve(name, self.ds_ref, self.n_ref, self.m1, self.m2 if self.m2 is not None else self.m1,
+                       self.n_knee if self.n_knee is not None else self.n_ref, self.n_cutoff, partial_factor)
+
+
+def _sn_name(value: Any) -> str:
+    if not isinstance(value, str) or value not in sn_curve_names():
+        raise fail(choices_message(value, sn_curve_names(), "S-N curve") + " (or a table of the curve's constants)")
+    return value
+
+
 class SensorConfig(ConfigModel):
-    """``[[sensors]]``: a measured quantity at a deck point."""
+    """``[[sensors]]``: a measured quantity at a deck point, or a stress or strain at a section point."""
 
     name: Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
     x: Number
     y: Number = 0.0
+    z: Number | None = None
+    omega: Number | None = None
     quantity: Annotated[str, choice(QUANTITIES, "quantity")] = "displacement"
+    sn_curve: Annotated[str, PlainValidator(_sn_name)] | SNCurveConfig | None = None
+    partial_factor: Positive = 1.0
+
+    @model_validator(mode="after")
+    def _section_point(self) -> SensorConfig:
+        on_section = self.quantity in SECTION_POINT_QUANTITIES
+        if on_section and self.z is None:
+            raise fail(f"required key is missing: quantity = {show(self.quantity)} is read at the section point "
+                       "(y, z); give z, m, in the frame the section is drawn in", "z")
+        for key in ("z", "omega"):
+            if not on_section and getattr(self, key) is not None:
+                raise fail(f"only used by the quantities {', '.join(SECTION_POINT_QUANTITIES)} "
+                           f"(got quantity = {show(self.quantity)})", key)
+        if self.sn_curve is not None and self.quantity not in ("stress", "shear_stress_xy", "shear_stress_xz"):
+            raise fail(f"only a stress sensor has an S-N curve (got quantity = {show(self.quantity)})", "sn_curve")
+        if self.partial_factor != 1.0 and self.sn_curve is None:
+            raise fail("only used with sn_curve", "partial_factor")
+        return self
+
+    def curve(self) -> SNCurve | None:
+        """The sensor's S-N curve (None without one)."""
+        if self.sn_curve is None:
+            return None
+        if isinstance(self.sn_curve, str):
+            return sn_curve(self.sn_curve, self.partial_factor)
+        return self.sn_curve.to_curve(f"{self.name} (given)", self.partial_factor)
+
+    def to_sensor(self) -> Sensor:
+        """The :class:`cosim.core.sensors.Sensor` this table describes."""
+        return Sensor(name=self.name, x=self.x, y=self.y, quantity=self.quantity, z=self.z, omega=self.omega)
 
 
 def _speed_profile(value: Any) -> tuple[tuple[float, float], ...]:
@@ -371,17 +438,34 @@ class SolverConfig(ConfigModel):
         )
 
 
+#: The largest exaggeration of the 3D scene: a millimetre drawn as a kilometre.
+MAX_SCENE_EXAGGERATION = 1e6
+
+
+def _scene(value: Any) -> bool | float:
+    """``scene = true | false | <exaggeration>``: the 3D scene on or off, or on with this exaggeration."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, (int, float)) and math.isfinite(value) and 0 < value <= MAX_SCENE_EXAGGERATION:
+        return float(value)
+    raise fail("expected true, false or the deck displacement's exaggeration in the 3D scene, a number > 0 and "
+               f"<= {MAX_SCENE_EXAGGERATION:g} (got {describe(value)})")
+
+
 class OutputConfig(ConfigModel):
-    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, and the logging rate.
+    """``[output]``: where the run's MCAP log (and an optional sensor CSV) go, the logging rate, the 3D scene.
 
     The rate is ``rate_hz`` (default :data:`DEFAULT_RATE_HZ`) or, for
-    compatibility, ``every`` (keep every N-th step); not both.
+    compatibility, ``every`` (keep every N-th step); not both. ``scene``: the
+    log's 3D scene (:mod:`cosim.log.scene`) on or off, or on with a chosen
+    exaggeration; unset, it is on for runs of at most an hour.
     """
 
     log: Annotated[str, Strict(), Field(min_length=1)] | None = None
     rate_hz: Positive | None = None
     every: PositiveInt | None = None
     csv: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    scene: Annotated[bool | float, PlainValidator(_scene)] | None = None
 
     @model_validator(mode="after")
     def _one_rate(self) -> OutputConfig:

@@ -7,6 +7,10 @@ DISPLAY_UNITS: dict[str, tuple[str, float]] = {
     "velocity": ("mm/s", 1e3),
     "acceleration": ("m/s^2", 1.0),
     "bending_moment": ("kN m", 1e-3),
+    "stress": ("MPa", 1e-6),
+    "strain": ("µε", 1e6),
+    "shear_stress_xy": ("MPa", 1e-6),
+    "shear_stress_xz": ("MPa", 1e-6),
 }
 #: For a quantity without a display unit: SI, unscaled.
 SI = ("SI", 1.0)

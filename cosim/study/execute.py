@@ -27,6 +27,7 @@ from typing import Any
 from cosim.errors import ConfigError, CosimError, Interrupted, interruption
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
+from cosim.study.characteristic import write_characteristic
 from cosim.study.folder import (
     LOG_FILE,
     PLOTS_FOLDER,
@@ -100,8 +101,10 @@ def execute_run(task: RunTask) -> dict[str, Any]:
         write_file(folder / SCENARIO_FILE, task.scenario_text)
         scenario = load_scenario(folder / SCENARIO_FILE)
         bridge = scenario.build_bridge()
-        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge, progress=_StopCheck(stop))
-        row.update(run_statistics(scenario, bridge, outcome, task.percentiles))
+        # a study's runs are reduced to numbers: no 3D scene unless its scenario asks for one
+        outcome = run_logged(scenario, folder / LOG_FILE, force=True, bridge=bridge, progress=_StopCheck(stop),
+                             scene_by_default=False)
+        row.update(run_statistics(scenario, bridge, outcome, task.percentiles, task.vehicles_per_year))
         row["status"] = "ok"
         row["error"] = ""
     except KeyboardInterrupt as exc:
@@ -184,6 +187,7 @@ class StudyOutcome:
         plots: the PNG files written.
         wall_time: s, the whole study (cluster start-up included).
         workers: how many workers ran the runs (0: in this process).
+        characteristic: ``characteristic.csv`` when the study asks for ``[extremes]``.
     """
 
     study: Study
@@ -196,6 +200,7 @@ class StudyOutcome:
     plots: list[Path]
     wall_time: float
     workers: int
+    characteristic: Path | None = None
 
     def table(self):  # noqa: ANN201 - pandas is imported lazily
         """The results as a pandas DataFrame (the rows of ``results.csv``)."""
@@ -223,6 +228,8 @@ def summary_text(outcome: StudyOutcome) -> str:
         f"Wall time: {outcome.wall_time:.3g} s",
         f"Table: {outcome.table_csv} and {outcome.table_parquet.name} ({len(rows)} rows)",
     ]
+    if outcome.characteristic is not None:
+        lines.append(f"Characteristic values: {outcome.characteristic}")
     if outcome.plots:
         lines.append(f"Plots: {len(outcome.plots)} PNG in {outcome.plots[0].parent}")
     if outcome.failed:
@@ -321,12 +328,15 @@ def run_study(
         raise
     ordered = [rows[t.run_id] for t in tasks]
     csv_path, parquet_path = write_table(ordered, output)
-    pngs = plot_study(ordered, study, output / PLOTS_FOLDER) if (study.plots if plots is None else plots) else []
+    draw = study.plots if plots is None else plots
+    pngs = plot_study(ordered, study, output / PLOTS_FOLDER) if draw else []
+    characteristic, level_plots = write_characteristic(ordered, study, output, plots=draw)
+    pngs += level_plots
     return StudyOutcome(
         study=study, rows=ordered, ran=[t.run_id for t in todo], skipped=skipped,
         failed=[r["run_id"] for r in ordered if r.get("status") != "ok"],
         table_csv=csv_path, table_parquet=parquet_path, plots=pngs,
-        wall_time=time.perf_counter() - started, workers=used,
+        wall_time=time.perf_counter() - started, workers=used, characteristic=characteristic,
     )
 
 

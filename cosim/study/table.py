@@ -66,13 +66,17 @@ def base_row(task: RunTask) -> dict[str, Any]:
     return {"run_id": task.run_id, "status": "error", **task.parameters}
 
 
-def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: Sequence[float]) -> dict[str, Any]:
-    """Peaks, percentiles, RMS, quasi-static peak and DAF per sensor; vehicle counts of the run.
+def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: Sequence[float],
+                   vehicles_per_year: float | None = None) -> dict[str, Any]:
+    """Peaks, percentiles, RMS, quasi-static peak and DAF per sensor; fatigue of the stress sensors with an S-N
+    curve; vehicle counts of the run.
 
     Args:
         scenario, bridge: what ran.
         outcome: the finished logged run (:class:`cosim.run.logged.RunOutcome`).
         percentiles: of |value| per sensor, in percent.
+        vehicles_per_year: the stated traffic volume the damage per year is scaled to (None: the run's traffic
+            all year).
     """
     result = outcome.result
     sensors = scenario.sensors_core()
@@ -97,6 +101,15 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
         row[f"{name}.static_peak"] = qs.peak[name]
         row[f"{name}.daf"] = daf(peak, qs.peak[name])
+    for name, fat in outcome.fatigue.items():
+        per_year = fat.damage_per_year
+        if vehicles_per_year is not None:
+            per_year = fat.damage * vehicles_per_year / len(result.vehicle_ids) if result.vehicle_ids else None
+        row[f"{name}.cycles"] = fat.cycles
+        row[f"{name}.damage"] = fat.damage
+        row[f"{name}.damage_per_year"] = per_year
+        row[f"{name}.equivalent_stress_range"] = fat.equivalent_stress_range
+        row[f"{name}.max_stress_range"] = fat.max_stress_range
     row.update({
         "vehicles": len(result.vehicle_ids),
         "max_on_deck": result.max_on_deck,
@@ -166,8 +179,13 @@ def plotted_statistics(study: Study, frame: Any) -> list[tuple[str, str, float]]
     from cosim.run.units import DISPLAY_UNITS
 
     out = []
-    for sensor in study.base.sensors:
+    for sensor in study.all_sensors:
         unit, factor = DISPLAY_UNITS.get(sensor.quantity, ("SI", 1.0))
+        for stat, label, scale in (("damage_per_year", "Miner damage per year", 1.0),
+                                   ("equivalent_stress_range", "equivalent stress range [MPa]", 1e-6)):
+            column = f"{sensor.name}.{stat}"
+            if column in frame and np.isfinite(frame[column].to_numpy(dtype=float)).any():
+                out.append((column, f"{sensor.name}: {label}", scale))
         for stat, what in (("peak", "peak |value|"), ("rms", "RMS"), ("daf", "DAF")):
             column = f"{sensor.name}.{stat}"
             if column not in frame or not np.isfinite(frame[column].to_numpy(dtype=float)).any():

@@ -1,31 +1,38 @@
 """SUMO adapter: the only module that imports libsumo.
 
-SUMO runs at its own step; every step the adapter reads, through
-subscriptions (no per-vehicle getter calls in the loop), the vehicles near
-the bridge: position (front bumper), heading, speed,
-acceleration and type. Each vehicle becomes one quarter-car per axle (a vType
-without axles: one at its centre, half its length behind the bumper along the
-heading), projected onto the bridge axis (x along the axis from its start
-point, y to the left of it).
-The frames feed :class:`cosim.core.traffic.FrameTraffic`, which the beam sub-steps
-through with SUMO's ballistic motion between frames.
+SUMO runs at its own step. The adapter watches the lanes on which a vehicle
+can have an axle on the deck (:func:`cosim.sumo.network.watched_lanes`: the
+deck's lanes, the junction lanes at its ends and the lanes before and after,
+as far as the longest vehicle reaches) and reads, through subscriptions (no
+per-vehicle getter calls in the loop), each vehicle on them: position (front
+bumper), heading, speed, acceleration and type. A vehicle is followed by
+position, not by the edge it is on: it stays in the frames while it crosses
+the junction at a deck end, so each of its axles is on the deck from the
+moment it passes one end until it passes the other. Each vehicle becomes one
+quarter-car per axle (:mod:`cosim.sumo.vtypes`), its distance behind the
+bumper along the heading, projected onto the bridge axis (x along the axis
+from its start point, y to the left of it); it loads the deck while that
+projection lies on it (:func:`cosim.core.traffic.on_deck`) within the deck's
+width. The frames feed :class:`cosim.core.traffic.FrameTraffic`, which the
+beam sub-steps through with SUMO's ballistic motion between frames.
+
+The user's SUMO config stays theirs: SUMO runs on a copy of it and the files
+it names in a scratch folder, with its messages (log, warnings, errors) going
+to a file there that cosim reads (:attr:`SumoTraffic.messages`), nothing on
+the terminal, and every output the config asks for (trip info, detectors,
+...) written into that folder and discarded with it.
 
 ``libsumo`` is a per-process singleton: one SUMO simulation per process; it is
 imported inside :meth:`SumoTraffic.start`, so importing this module does not load it.
-What a vType is for the beam lives in :mod:`cosim.sumo.vtypes`, the reading of
-SUMO's files in :mod:`cosim.sumo.files`.
 """
 from __future__ import annotations
 
 import contextlib
-import difflib
-import functools
-import math
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -35,12 +42,22 @@ import numpy as np
 from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError
-from cosim.sumo.files import DEMAND_OPTIONS, distribution_ids, parse_xml, read_config, read_input
-from cosim.sumo.vtypes import PARAM_KEYS, PARAM_PREFIX, axles_from_parameters, model_from_parameters, scaled_model
+from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
+from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
+from cosim.sumo.vtypes import VehicleType, vehicle_type
 
-__all__ = ["WATCH_MARGIN", "BridgeAxis", "SumoTraffic", "bundled_networks", "sumo_binary"]
+__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic",
+           "bundled_networks", "sumo_binary"]
 
-WATCH_MARGIN = 12.0  # m: watch edges reaching this far past the deck ends (half the longest vehicle + slack)
+#: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
+WATCH_MARGIN = 12.0
+#: SUMO's messages (its log, warnings and errors) in the scratch folder, and the log's attachment of them.
+MESSAGES_FILE = "sumo-messages.log"
+#: The log's attachment with the vehicle types of the run (model, mass, axles and their sources).
+VEHICLE_TYPES_ATTACHMENT = "vehicle-types.json"
+_EMPTY = np.zeros(0)
+#: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
+_BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
 
 
 def bundled_networks() -> Path:
@@ -58,47 +75,50 @@ def sumo_binary() -> str:
         return "sumo"
 
 
-@dataclass(frozen=True)
-class BridgeAxis:
-    """The bridge in network coordinates: its axis from ``start`` to ``end`` (m)."""
+@contextlib.contextmanager
+def _captured_output(into: Path) -> Iterator[None]:
+    """Whatever the process writes on its standard output and error inside the block goes to ``into``.
 
-    start: tuple[float, float]
-    end: tuple[float, float]
-
-    @property
-    def length(self) -> float:
-        return math.dist(self.start, self.end)
-
-    @functools.cached_property
-    def _frame(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.unit()
-
-    def unit(self) -> tuple[np.ndarray, np.ndarray]:
-        e = (np.asarray(self.end, dtype=float) - np.asarray(self.start, dtype=float)) / self.length
-        return e, np.array([-e[1], e[0]])  # along, left normal
-
-    def project(self, px: np.ndarray, py: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Bridge coordinates (x along the axis from start, y to the left) of network points."""
-        e, n = self._frame
-        dx, dy = px - self.start[0], py - self.start[1]
-        return dx * e[0] + dy * e[1], dx * n[0] + dy * n[1]
+    SUMO reports a broken config on its standard error before its log exists;
+    libsumo only raises "Process Error". Redirected at the file-descriptor
+    level, since SUMO writes from C++.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(into, "ab") as sink:
+            os.dup2(sink.fileno(), 1)
+            os.dup2(sink.fileno(), 2)
+            try:
+                yield
+            finally:
+                os.dup2(saved[0], 1)
+                os.dup2(saved[1], 2)
+    finally:
+        for fd in saved:
+            os.close(fd)
 
 
 class SumoTraffic:
     """Vehicles from a SUMO simulation (through libsumo), as a traffic source for the beam.
 
     Args:
-        config: the ``.sumocfg`` to run.
+        config: the ``.sumocfg`` to run (it is copied with its files into a scratch folder and run there).
         axis: where the bridge is in the network.
         step: SUMO's step length, s (the beam's dt must divide it).
         begin, end: SUMO times to run, s (the co-simulation's t = 0 is ``begin``).
-        edges: edges to watch; default: every edge with a lane within
-            ``WATCH_MARGIN`` of the deck.
+        edges: the deck's edges; their lanes (and the opposite direction's between the same junctions)
+            are the deck's. Default: every lane running through the deck's box.
         seed: SUMO's random seed (recorded in the log), or None for the config's.
-        half_width: lateral half-width of the deck, m; vehicles farther from the
-            axis are not on the bridge.
+        half_width: lateral half-width of the deck, m, when ``deck_y`` is not given.
         extra_args: further SUMO command-line options.
-        frame_sink: called with every frame and the model table (e.g. a log's TrafficLogger).
+        frame_sink: called with every frame and the model table (e.g. a log's TrafficLogger); if it has
+            an ``attach(name, data, media_type)`` method, the vehicle types (at the start) and SUMO's
+            messages (at the end) are given to it too.
+        deck_y: the deck's lateral extent (y_min, y_max), m: an axle outside it is not on the bridge.
+        demand: the config's demand files as read (:func:`cosim.sumo.files.read_demand`), if already read.
     """
 
     def __init__(
@@ -113,6 +133,8 @@ class SumoTraffic:
         half_width: float = 50.0,
         extra_args: Sequence[str] = (),
         frame_sink: Callable[[Frame, dict[str, VehicleModel]], None] | None = None,
+        deck_y: tuple[float, float] | None = None,
+        demand: Demand | None = None,
     ) -> None:
         self.config = Path(config)
         if not self.config.is_file():
@@ -122,125 +144,216 @@ class SumoTraffic:
         if not end > begin:
             raise ConfigError(f"traffic `end` ({end} s) must be after `begin` ({begin} s)")
         self.axis, self.step, self.begin, self.end = axis, float(step), float(begin), float(end)
-        self.seed, self.half_width = seed, float(half_width)
+        self.seed = seed
+        self.deck_y = (float(deck_y[0]), float(deck_y[1])) if deck_y is not None else (-half_width, half_width)
+        self.half_width = max(abs(self.deck_y[0]), abs(self.deck_y[1]))
         self._edges_wanted = tuple(edges) if edges else None
         self.extra_args = tuple(extra_args)
         self.frame_sink = frame_sink
+        self.demand = demand
         self.edges: tuple[str, ...] = ()
+        self.lanes: tuple[str, ...] = ()
+        self.deck_lanes: tuple[str, ...] = ()
+        self.reach = WATCH_MARGIN
         self.models: dict[str, VehicleModel] = {}
+        self.types: dict[str, VehicleType] = {}
         self.frames: FrameTraffic | None = None
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
         self.sumo_steps = 0
         self.teleports = 0
+        self.messages = ""  # SUMO's own messages, once closed
+        self._scratch: Path | None = None
+        self._watched: set[str] = set()
+        self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
 
     # ------------------------------------------------------------- lifecycle
-    def start(self) -> "SumoTraffic":
+    def start(self) -> SumoTraffic:
         import libsumo  # the one place cosim imports libsumo
 
-        self.libsumo = libsumo
+        if self.demand is None:
+            self.demand = read_demand(self.config)
+        self._scratch = Path(tempfile.mkdtemp(prefix="cosim-sumo-"))
+        try:
+            config = write_sumo_set(read_sumo_set(self.config, self.config.stem), self._scratch)
+        except Exception:
+            self._remove_scratch()
+            raise
+        messages = self._scratch / MESSAGES_FILE
         cmd = [
-            sumo_binary(), "-c", str(self.config),
+            sumo_binary(), "-c", str(config),
             "--step-length", repr(self.step),
             "--begin", repr(self.begin), "--end", repr(self.end),
             "--step-method.ballistic", "true",
-            "--no-step-log", "true", "--no-warnings", "true",
+            # SUMO's messages into the scratch folder, none on the terminal (warnings included:
+            # --no-warnings keeps them off the terminal, --error-log still writes them).
+            "--verbose", "false", "--no-step-log", "true", "--no-warnings", "true",
+            "--log", str(messages), "--error-log", str(messages),
+            "--gui-settings-file", "",  # a GUI-only file (a user's config may name one that is not there)
             *(["--seed", str(self.seed)] if self.seed is not None else []),
             *self.extra_args,
         ]
-        check_vtype_params(self.config)
-        with _stderr_captured() as captured:
-            try:
+        self.libsumo = libsumo
+        try:
+            with _captured_output(self._scratch / "console.txt"):
                 libsumo.start(cmd)
-            except Exception as exc:  # libsumo raises its own error types; SUMO printed the reason
-                raise SumoError(f"{self.config}: SUMO could not load it: {_sumo_reason(captured(), exc)}") from None
+        except Exception as exc:  # libsumo raises its own error types; SUMO said why on its console
+            self.libsumo = None
+            reason = self._sumo_error() or _first_line(exc)
+            self._remove_scratch()
+            raise SumoError(f"{self.config}: SUMO could not load it: {reason}") from None
         try:
             self._watch()
             # Every vType known at the start is turned into its vehicle model now, so that an
             # impossible parameter stops the run before it starts, naming the vType.
-            distributions = distribution_ids(self.config)
             for type_id in libsumo.vehicletype.getIDList():
-                if type_id not in distributions:  # a distribution's id is not a vehicle's type
+                if type_id not in self.demand.distributions and type_id not in _BUILT_IN_OTHER:
                     self._model(type_id)
+            self._extend_reach()
+            attach = getattr(self.frame_sink, "attach", None)
+            if attach is not None:
+                import json
+
+                attach(VEHICLE_TYPES_ATTACHMENT, json.dumps([t.summary() for t in self.table()], indent=1),
+                       "application/json")
         except Exception:
             self.close()
             raise
+        self._unit = self.axis.unit()
         self.frames = FrameTraffic(self.step, self.axis.length, self.models)
         return self
+
+    def log_documents(self, attach: Callable[[str, bytes | str, str], None]) -> None:
+        """Attach the vehicle-type table (model, mass, axles and their sources) to a log opened after the start."""
+        import json
+
+        attach(VEHICLE_TYPES_ATTACHMENT, json.dumps([t.summary() for t in self.table()], indent=1), "application/json")
 
     def close(self) -> None:
         if self.libsumo is not None:
             try:
-                self.libsumo.close()
+                with _captured_output(self._scratch / "console.txt") if self._scratch else contextlib.nullcontext():
+                    self.libsumo.close()
             except Exception:  # noqa: BLE001 - closing a failed simulation must not mask the first error
                 pass
             self.libsumo = None
+        if self._scratch is not None:
+            self.messages = self._read_messages()
+            attach = getattr(self.frame_sink, "attach", None)
+            if attach is not None and self.messages:
+                with contextlib.suppress(Exception):  # the log may already be closed (its own failure)
+                    attach(MESSAGES_FILE, self.messages, "text/plain")
+            self._remove_scratch()
 
-    def __enter__(self) -> "SumoTraffic":
+    def __enter__(self) -> SumoTraffic:
         return self.start()
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
+    def _read_messages(self) -> str:
+        assert self._scratch is not None
+        parts = []
+        for name in ("console.txt", MESSAGES_FILE):
+            path = self._scratch / name
+            if path.is_file():
+                with contextlib.suppress(OSError):
+                    parts.append(path.read_text(encoding="utf-8", errors="replace"))
+        return "".join(parts)
+
+    def _sumo_error(self) -> str:
+        """SUMO's first error line ("Error: ..."), from its console or its log."""
+        if self._scratch is None:
+            return ""
+        for line in self._read_messages().splitlines():
+            if line.startswith("Error:"):
+                return line[len("Error:"):].strip()
+        return ""
+
+    def _remove_scratch(self) -> None:
+        if self._scratch is not None:
+            shutil.rmtree(self._scratch, ignore_errors=True)
+            self._scratch = None
+
+    def table(self) -> list[VehicleType]:
+        """Every vType of the demand files (and SUMO's default one when a vehicle names no type) as the beam
+        sees it: as SUMO resolved it, or, for one SUMO has not loaded yet (route files load as the run goes),
+        as its file says."""
+        demand = self.demand or Demand()
+        wanted = [t for t in demand.vtypes if t not in demand.distributions]
+        if demand.untyped:
+            wanted.append("DEFAULT_VEHTYPE")
+        out = []
+        for type_id in wanted:
+            if type_id in self.types:
+                out.append(self.types[type_id])
+                continue
+            entry = demand.vtypes.get(type_id)
+            if entry is not None:
+                out.append(vehicle_type(type_id, entry.vclass or "passenger", entry.length, entry.mass, entry.params))
+        return out
+
     def _watch(self) -> None:
+        """The deck's lanes (the named edges', or those through the deck's box); the watched lanes around them."""
+        net = net_path(self.config)
+        try:
+            if self._edges_wanted is not None:
+                location = locate_bridge(net, self._edges_wanted)
+                self.edges = (*location.edges, *location.opposite)
+                deck = location.deck_lanes
+            else:
+                deck = lanes_across(net, self.axis, self.deck_y)
+                self.edges = tuple(dict.fromkeys(lane.rsplit("_", 1)[0] for lane in deck))
+        except ConfigError as exc:
+            raise SumoError(f"{self.config}: {exc}") from None
+        if not deck:
+            raise SumoError(
+                f"{self.config}: no lane of the network lies on the bridge axis "
+                f"{self.axis.start} -> {self.axis.end}; check [traffic] axis or edges"
+            )
+        self.deck_lanes = tuple(deck)
         ls = self.libsumo
-        all_edges = [e for e in ls.edge.getIDList() if not e.startswith(":")]
-        if self._edges_wanted is not None:
-            missing = [e for e in self._edges_wanted if e not in all_edges]
-            if missing:
-                raise SumoError(f"{self.config}: the network has no edge(s) {', '.join(missing)} (bridge edges)")
-            edges = list(self._edges_wanted)
-        else:
-            edges = []
-            L = self.axis.length
-            for edge in all_edges:
-                for i in range(ls.edge.getLaneNumber(edge)):
-                    shape = np.array(ls.lane.getShape(f"{edge}_{i}"))
-                    x, y = self.axis.project(shape[:, 0], shape[:, 1])
-                    # Sample the polyline densely enough to see it cross the watched box.
-                    t = np.linspace(0, 1, 50)
-                    xs = np.concatenate([np.interp(t, [0, 1], x[j:j + 2]) for j in range(len(x) - 1)])
-                    ys = np.concatenate([np.interp(t, [0, 1], y[j:j + 2]) for j in range(len(y) - 1)])
-                    inside = (xs > -WATCH_MARGIN) & (xs < L + WATCH_MARGIN) & (np.abs(ys) <= self.half_width)
-                    if inside.any():
-                        edges.append(edge)
-                        break
-            if not edges:
-                raise SumoError(
-                    f"{self.config}: no edge of the network lies on the bridge axis "
-                    f"{self.axis.start} -> {self.axis.end}; check [traffic] axis or edges"
-                )
         tc = ls.constants
-        # Edge context subscriptions miss vehicles at some steps (their spatial query works
-        # on edge shapes, cf. eclipse-sumo/sumo#16422), so: each watched edge reports its vehicle
-        # list, and each vehicle seen there is subscribed to its own variables until it leaves.
-        for edge in edges:
-            ls.edge.subscribe(edge, [tc.LAST_STEP_VEHICLE_ID_LIST])
-        self.edges = tuple(edges)
         self._vars = [tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE,
                       tc.VAR_LENGTH]
-        self._watched: set[str] = set()
+        self._subscribed_lanes: set[str] = set()
+        self._subscribe_lanes(net)
+
+    def _subscribe_lanes(self, net: Path) -> None:
+        """Watch the lanes within :attr:`reach` of the deck (edge context subscriptions miss vehicles at some
+        steps, cf. eclipse-sumo/sumo#16422: each watched lane reports its vehicle list instead)."""
+        ls = self.libsumo
+        lanes = watched_lanes(net, self.deck_lanes, self.reach)
+        for lane in lanes:
+            if lane not in self._subscribed_lanes:
+                ls.lane.subscribe(lane, [ls.constants.LAST_STEP_VEHICLE_ID_LIST])
+                self._subscribed_lanes.add(lane)
+        self.lanes = tuple(self._subscribed_lanes)
+
+    def _extend_reach(self) -> None:
+        """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
+        longest = max((t.length for t in self.types.values()), default=0.0)
+        wanted = max(WATCH_MARGIN, longest + REACH_SLACK)
+        if wanted > self.reach + 1e-9 or not self.lanes:
+            self.reach = wanted
+            self._subscribe_lanes(net_path(self.config))
 
     # --------------------------------------------------------------- stepping
     def _model(self, type_id: str) -> None:
-        if type_id in self.models:
+        if type_id in self.types:
             return
-        ls = self.libsumo
-        vt = ls.vehicletype
-        params = {}
-        for key in PARAM_KEYS:
-            value = vt.getParameter(type_id, PARAM_PREFIX + key)
-            if value != "":
-                params[PARAM_PREFIX + key] = value
-        whole = model_from_parameters(type_id, vt.getMass(type_id), vt.getVehicleClass(type_id), params)
-        axles = axles_from_parameters(type_id, vt.getLength(type_id), params)
-        self._axles[type_id] = axles
-        if len(axles) == 1:
-            self.models[type_id] = whole
-        else:  # one vehicle model per axle: "type#k" carries axle k's share
-            for k, (_, share) in enumerate(axles):
-                self.models[f"{type_id}#{k}"] = scaled_model(whole, share)
-            self.models[type_id] = whole
+        vt = self.libsumo.vehicletype
+        demand = self.demand or Demand()
+        entry = demand.vtypes.get(type_id)
+        # The vType's own mass only when its file sets one: SUMO's default masses are never used.
+        mass = entry.mass if entry is not None else None
+        params = entry.params if entry is not None else {}
+        typ = vehicle_type(type_id, vt.getVehicleClass(type_id), vt.getLength(type_id), mass, params)
+        self.types[type_id] = typ
+        self._axles[type_id] = typ.axles
+        self.models.update(typ.axle_models())
+        if len(typ.axles) > 1:
+            self.models[type_id] = typ.model
 
     def advance(self) -> Frame:
         """One SUMO step; returns the frame of vehicles near the bridge."""
@@ -252,10 +365,13 @@ class SumoTraffic:
             raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {_first_line(exc)}") \
                 from None
         self.sumo_steps += 1
+        t = self.sumo_steps * self.step
         tc = ls.constants
         present: set[str] = set()
-        for edge in self.edges:
-            present.update(ls.edge.getSubscriptionResults(edge)[tc.LAST_STEP_VEHICLE_ID_LIST])
+        for result in ls.lane.getAllSubscriptionResults().values():
+            present.update(result[tc.LAST_STEP_VEHICLE_ID_LIST])
+        self._done &= present  # a vehicle that left the watched lanes is forgotten
+        present -= self._done
         for vid in present - self._watched:
             ls.vehicle.subscribe(vid, self._vars)
         for vid in self._watched - present:
@@ -264,41 +380,76 @@ class SumoTraffic:
             except Exception:  # noqa: BLE001 - it arrived or was teleported away: nothing to undo
                 pass
         self._watched = present
+        if not present:
+            return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
         results = ls.vehicle.getAllSubscriptionResults()
-        ids = [vid for vid in sorted(present) if vid in results]
-        n = len(ids)
+        ids = sorted(vid for vid in present if vid in results)
         rows = [results[vid] for vid in ids]
-        pos = np.array([r[tc.VAR_POSITION] for r in rows], dtype=float).reshape(n, 2)
-        ang = np.fromiter((r[tc.VAR_ANGLE] for r in rows), dtype=float, count=n)
-        spd = np.fromiter((r[tc.VAR_SPEED] for r in rows), dtype=float, count=n)
-        acc = np.fromiter((r[tc.VAR_ACCELERATION] for r in rows), dtype=float, count=n)
-        length = np.fromiter((r[tc.VAR_LENGTH] for r in rows), dtype=float, count=n)
-        types = [r[tc.VAR_TYPE] for r in rows]
-        for typ in types:
-            if typ not in self.models:
+        P, H, S, A, T = tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE
+        types = [r[T] for r in rows]
+        for typ in dict.fromkeys(types):
+            if typ not in self.types:
                 self._model(typ)
+                self._extend_reach()  # a longer vehicle than any known so far: watch farther
         # One contact point per axle (a vType without axles: one at mid-length), behind the bumper.
-        back = np.array([d if len(self._axles[t]) > 1 else 0.5 * L
-                         for t, L in zip(types, length) for d, _ in self._axles[t]], dtype=float)
-        owner = np.array([i for i, t in enumerate(types) for _ in self._axles[t]], dtype=np.int64)
-        if len(owner) != n:
-            ids = [vid if len(self._axles[t]) == 1 else f"{vid}#{k}"
-                   for vid, t in zip(ids, types) for k in range(len(self._axles[t]))]
-            types = [t if len(self._axles[t]) == 1 else f"{t}#{k}"
-                     for t in types for k in range(len(self._axles[t]))]
-            pos, ang, spd, acc = pos[owner], ang[owner], spd[owner], acc[owner]
-        heading = np.radians(ang)
+        num = np.array([(r[P][0], r[P][1], r[H], r[S], r[A], r[tc.VAR_LENGTH]) for r in rows], dtype=float)
+        self._drop_departed(ids, num)
+        if all(len(self._axles[typ]) == 1 for typ in types):
+            back = 0.5 * num[:, 5]
+        else:
+            owner = np.array([i for i, typ in enumerate(types) for _ in self._axles[typ]], dtype=np.int64)
+            back = np.array([d if len(self._axles[typ]) > 1 else 0.5 * length
+                             for typ, length in zip(types, num[:, 5]) for d, _ in self._axles[typ]], dtype=float)
+            ids = [vid if len(self._axles[typ]) == 1 else f"{vid}#{k}"
+                   for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
+            types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
+                     for typ in types for k in range(len(self._axles[typ]))]
+            num = num[owner]
+        e, n = self._unit
+        heading = np.radians(num[:, 2])
         hx, hy = np.sin(heading), np.cos(heading)  # SUMO angle: 0 = north, clockwise
-        x, y = self.axis.project(pos[:, 0] - back * hx, pos[:, 1] - back * hy)
-        e, _ = self.axis._frame
+        dx = num[:, 0] - back * hx - self.axis.start[0]
+        dy = num[:, 1] - back * hy - self.axis.start[1]
+        x, y = dx * e[0] + dy * e[1], dx * n[0] + dy * n[1]
         along = hx * e[0] + hy * e[1]
-        keep = np.abs(y) <= self.half_width
-        t = self.sumo_steps * self.step
+        # Axles on the deck's width and within the watched reach along it (a vehicle on a long lane
+        # after the deck is dropped once far from it).
+        keep = (y >= self.deck_y[0]) & (y <= self.deck_y[1]) & (x >= -self.reach) & (x <= self.axis.length
+                                                                                     + self.reach)
+        spd, acc = num[:, 3], num[:, 4]
+        if not keep.all() and len(keep) != len(rows):  # a vehicle's axles stay together (one body, several axles)
+            whole = np.zeros(len(rows), dtype=bool)
+            np.logical_or.at(whole, owner, keep)
+            keep = whole[owner]
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]
             x, y, spd, acc, along = x[keep], y[keep], spd[keep], acc[keep], along[keep]
         return Frame(t=t, ids=tuple(ids), x=x, y=y, v=spd * along, a=acc * along, types=tuple(types))
+
+    def _drop_departed(self, ids: list[str], num: np.ndarray) -> None:
+        """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
+
+        They are still on a watched lane (a long lane after the deck) but can no longer reach it: they are
+        unsubscribed now, not at every step until they leave the lane. ``num`` rows: x, y, angle, ...,
+        length (network coordinates, the front bumper).
+        """
+        heading = np.radians(num[:, 2])
+        hx, hy = np.sin(heading), np.cos(heading)
+        e, _ = self._unit
+        front = (num[:, 0] - self.axis.start[0]) * e[0] + (num[:, 1] - self.axis.start[1]) * e[1]
+        along = hx * e[0] + hy * e[1]
+        rear = front - num[:, 5] * along
+        far = self.axis.length + self.reach
+        gone = ((along > 0) & (np.minimum(front, rear) > far)) | ((along < 0) & (np.maximum(front, rear) < -self.reach))
+        for i in np.flatnonzero(gone):
+            vid = ids[i]
+            self._done.add(vid)
+            self._watched.discard(vid)
+            try:
+                self.libsumo.vehicle.unsubscribe(vid)
+            except Exception:  # noqa: BLE001 - nothing to undo
+                pass
 
     def block(self, times: np.ndarray) -> TrafficBlock:
         """Run SUMO as far as ``times`` (s from ``begin``) need and interpolate the vehicles there."""
@@ -314,98 +465,6 @@ class SumoTraffic:
         out = self.frames.block(times)
         self.frames.forget_before(float(times[-1]))
         return out
-
-
-@contextlib.contextmanager
-def _stderr_captured() -> Iterator[Callable[[], str]]:
-    """Within the block, what is written to file descriptor 2 (SUMO's C++ error output) goes to a
-    temporary file; yields a function that returns it. Written back to stderr when the block ends
-    normally, so nothing is lost; on an error the caller words it into its one line instead."""
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 2)
-        text: list[str] = []
-
-        def captured() -> str:
-            if not text:
-                sink.seek(0)
-                text.append(sink.read(1 << 16).decode("utf-8", "replace"))
-            return text[0]
-
-        failed = True
-        try:
-            yield captured
-            failed = False
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            if not failed and captured().strip():
-                print(captured().rstrip(), file=sys.stderr)
-
-
-def _sumo_reason(output: str, exc: BaseException) -> str:
-    """SUMO's own reason, from what it printed ("Error: ..." and the lines below it), on one line."""
-    lines = [line.strip() for line in output.splitlines()]
-    starts = [i for i, line in enumerate(lines) if line.startswith("Error:")]
-    if not starts:
-        return _first_line(exc)
-    first = starts[0]
-    detail = [lines[first][len("Error:"):].strip()]
-    for line in lines[first + 1:]:
-        if not line or line.startswith(("Error:", "Quitting", "Warning:")):
-            break
-        detail.append(line[0].lower() + line[1:])
-    return " ".join(part.rstrip(".") for part in detail if part)
-
-
-def check_vtype_params(config: str | os.PathLike) -> None:
-    """Every ``cosim.*`` param of every vType in a config's demand files is one cosim reads, for its model.
-
-    A misspelled key (``cosim.kv``) would otherwise leave the vClass default in
-    place, and ``cosim.k_t`` on a quarter-car would be ignored. Lenient about
-    files it cannot read (SUMO, which loads them next, judges those).
-
-    Raises:
-        SumoError: one line naming the file, the vType and the key, with the keys it may be.
-    """
-    try:
-        parsed = read_config(Path(config))
-    except ConfigError:
-        return
-    for path in parsed.files(DEMAND_OPTIONS):
-        try:
-            root = parse_xml(read_input(path), str(path))
-        except ConfigError:
-            continue
-        for vtype in root.iter("vType"):
-            params = {p.get("key", ""): p.get("value", "") for p in vtype.iter("param")}
-            model = params.get(PARAM_PREFIX + "model", "quarter-car")
-            allowed = _MODEL_PARAMS.get(model)
-            if allowed is None:
-                continue  # an unknown model: model_from_parameters names it
-            for key in params:
-                if not key.startswith(PARAM_PREFIX):
-                    continue
-                name = key[len(PARAM_PREFIX):]
-                if name in allowed:
-                    continue
-                where = f"{path}: vType {vtype.get('id', '?')}: param `{key}`"
-                if name in PARAM_KEYS:
-                    raise SumoError(f"{where} is not used by model {model} (its params: "
-                                    + ", ".join(PARAM_PREFIX + k for k in allowed) + ")")
-                near = difflib.get_close_matches(name, PARAM_KEYS, n=1)
-                hint = f"; did you mean `{PARAM_PREFIX}{near[0]}`?" if near else ""
-                raise SumoError(f"{where} is not a cosim param{hint} (cosim reads: "
-                                + ", ".join(PARAM_PREFIX + k for k in PARAM_KEYS) + ")")
-
-
-#: The ``cosim.*`` params each vehicle model uses (the others would be ignored: an error).
-_MODEL_PARAMS: dict[str, tuple[str, ...]] = {
-    "quarter-car": ("model", "m_w", "k_v", "c_v", "axles", "axle_loads"),
-    "tyre-quarter-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads"),
-    "moving-force": ("model", "axles", "axle_loads"),
-}
 
 
 def _first_line(exc: BaseException) -> str:

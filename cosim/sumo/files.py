@@ -1,9 +1,12 @@
 """SUMO input files: the one reader and editor of ``.sumocfg`` configs and the files they name.
 
 A SUMO config is read as XML, never run: cosim needs the files it names to
-embed them in a log (:func:`sumo_input_files`), to know which vType ids are
-distributions (:func:`distribution_ids`) and to copy and edit a demand for a
-study run (:func:`read_sumo_set` and the ``set_*`` edits).
+embed them in a log (:func:`sumo_input_files`), to know the vTypes of the
+demand, which ids are distributions and how many vehicles depart
+(:func:`read_demand`, :func:`distribution_ids`), to run SUMO on a copy in a
+scratch folder so that nothing is written next to the user's files
+(:func:`write_sumo_set`), and to copy and edit a demand for a study run
+(:func:`read_sumo_set` and the ``set_*`` edits).
 
 The rules, the same for every caller:
 
@@ -20,10 +23,13 @@ The rules, the same for every caller:
 """
 from __future__ import annotations
 
+import functools
 import gzip
+import io
+import math
 import xml.etree.ElementTree as ET
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -34,11 +40,14 @@ from cosim.sumo.vtypes import HEAVY_VCLASSES
 __all__ = [
     "DEMAND_OPTIONS",
     "FILE_OPTIONS",
+    "Demand",
     "SumoConfig",
     "SumoSet",
+    "VTypeEntry",
     "distribution_ids",
     "number_text",
     "read_config",
+    "read_demand",
     "read_input",
     "read_sumo_set",
     "set_speed_limit",
@@ -46,6 +55,7 @@ __all__ = [
     "set_vehicles_per_hour",
     "split_file_list",
     "sumo_input_files",
+    "write_sumo_set",
 ]
 
 #: The config options that name input files cosim reads, in the order they are listed.
@@ -218,6 +228,135 @@ def distribution_ids(config: str | Path) -> set[str]:
     return found
 
 
+@dataclass(frozen=True)
+class VTypeEntry:
+    """A ``<vType>`` as the demand files write it.
+
+    Attributes:
+        id: its id; vclass: its ``vClass`` (None: not given, SUMO's "passenger");
+        mass, length: its ``mass`` (kg) and ``length`` (m) attributes, or None when not given;
+        params: its ``<param key value>`` entries; file: the file it is in.
+    """
+
+    id: str
+    vclass: str | None
+    mass: float | None
+    length: float | None
+    params: dict[str, str]
+    file: str
+
+
+@dataclass(frozen=True)
+class Demand:
+    """What the route and additional files of a config hold, as far as cosim needs it.
+
+    Attributes:
+        vtypes: vType id -> :class:`VTypeEntry` (distributions' members included).
+        distributions: ids of the vTypeDistributions.
+        untyped: some vehicle, trip or flow names no type (SUMO gives it ``DEFAULT_VEHTYPE``).
+        vehicles: ``<vehicle>`` and ``<trip>`` elements; flows: ``<flow>`` elements.
+        departures: (first, last) numeric ``depart`` of the vehicles and trips, s, or None.
+    """
+
+    vtypes: dict[str, VTypeEntry] = field(default_factory=dict)
+    distributions: frozenset[str] = frozenset()
+    untyped: bool = False
+    vehicles: int = 0
+    flows: int = 0
+    departures: tuple[float, float] | None = None
+
+
+def _float_attr(element: ET.Element, key: str, where: str) -> float | None:
+    text = element.get(key)
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise ConfigError(f"{where}: `{key}` must be a number (got {text!r})") from None
+    if not (math.isfinite(value) and value > 0):
+        raise ConfigError(f"{where}: `{key}` must be a finite number > 0 (got {text!r})")
+    return value
+
+
+def _scan_demand(data: bytes, name: str) -> Demand:
+    """One pass over a route or additional file (streamed: big city demands stay out of memory)."""
+    vtypes: dict[str, VTypeEntry] = {}
+    distributions: set[str] = set()
+    untyped, vehicles, flows = False, 0, 0
+    first, last = math.inf, -math.inf
+    stack: list[str] = []
+    try:
+        for event, element in ET.iterparse(io.BytesIO(data), events=("start", "end")):
+            tag = element.tag
+            if event == "start":
+                stack.append(tag)
+                continue
+            stack.pop()
+            if tag == "vType":
+                tid = element.get("id", "")
+                where = f"{name}: vType {tid}"
+                vtypes[tid] = VTypeEntry(
+                    id=tid, vclass=element.get("vClass"), mass=_float_attr(element, "mass", where),
+                    length=_float_attr(element, "length", where),
+                    params={p.get("key", ""): p.get("value", "") for p in element.iter("param")}, file=name)
+            elif tag == "vTypeDistribution":
+                distributions.add(element.get("id", ""))
+            elif tag in ("vehicle", "trip", "flow"):
+                if not element.get("type") and "vTypeDistribution" not in stack:
+                    untyped = True
+                if tag == "flow":
+                    flows += 1
+                else:
+                    vehicles += 1
+                    try:
+                        depart = float(element.get("depart", ""))
+                    except ValueError:
+                        depart = math.nan
+                    if math.isfinite(depart):
+                        first, last = min(first, depart), max(last, depart)
+            if not stack or stack[-1] in ("routes", "additional"):
+                element.clear()  # a top-level element is done with: free it
+    except ET.ParseError as exc:
+        raise ConfigError(f"{name}: not well-formed XML ({exc})") from None
+    return Demand(vtypes, frozenset(distributions), untyped, vehicles, flows,
+                  (first, last) if vehicles and first <= last else None)
+
+
+@functools.lru_cache(maxsize=16)
+def _demand_of_file(path: str, size: int, mtime_ns: int) -> Demand:
+    return _scan_demand(read_input(Path(path)), str(path))
+
+
+def read_demand(config: str | Path) -> Demand:
+    """The vTypes, distributions and departures of a config's route and additional files (each once).
+
+    Raises:
+        ConfigError: the config or one of its demand files cannot be read or is not XML, or a vType's
+            ``mass`` or ``length`` is not a number > 0.
+    """
+    parsed = read_config(config)
+    vtypes: dict[str, VTypeEntry] = {}
+    distributions: set[str] = set()
+    untyped, vehicles, flows = False, 0, 0
+    first, last = math.inf, -math.inf
+    for path in parsed.files(DEMAND_OPTIONS):
+        try:
+            stat = path.stat()
+        except OSError as exc:
+            raise ConfigError(f"{parsed.path}: cannot read {path} ({exc.strerror})") from None
+        part = _demand_of_file(str(path), stat.st_size, stat.st_mtime_ns)
+        vtypes.update(part.vtypes)
+        distributions |= part.distributions
+        untyped = untyped or part.untyped
+        vehicles += part.vehicles
+        flows += part.flows
+        if part.departures is not None:
+            first, last = min(first, part.departures[0]), max(last, part.departures[1])
+    return Demand(vtypes, frozenset(distributions), untyped, vehicles, flows,
+                  (first, last) if first <= last else None)
+
+
 # --------------------------------------------------------------------------- a config with its files, and edits
 
 
@@ -285,11 +424,28 @@ def read_sumo_set(config: Path, label: str) -> SumoSet:
                    additional=tuple(named["additional-files"]), label=label)
 
 
+def write_sumo_set(sumo: SumoSet, folder: Path) -> Path:
+    """Write ``sumo``'s files into ``folder`` (flat, as named); returns the config written there."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, content in sumo.files.items():
+        (folder / name).write_bytes(content)
+    return folder / sumo.config
+
+
 def set_vehicles_per_hour(sumo: SumoSet, rate: float) -> SumoSet:
-    """Every ``<flow>`` of the route and additional files gets ``vehsPerHour = rate`` (other rate keys removed).
+    """The demand at ``rate`` vehicles per hour.
+
+    With ``<flow>`` elements: every flow of the route and additional files gets
+    ``vehsPerHour = rate`` (other rate keys removed), so each flow departs at
+    that rate. A demand of individual vehicles and trips (a city's, with no
+    flow) is scaled as a whole by SUMO's own ``scale`` option, set in the
+    config: ``rate`` / (its vehicles per hour between the first and the last
+    departure); SUMO then drops or duplicates vehicles at random, from the
+    run's seed.
 
     Raises:
-        ConfigError: no ``<flow>`` in the demand files, or one of them is not XML.
+        ConfigError: neither a ``<flow>`` nor two departures at different times in the demand files, or
+            one of them is not XML.
     """
     files = dict(sumo.files)
     count = 0
@@ -305,9 +461,30 @@ def set_vehicles_per_hour(sumo: SumoSet, rate: float) -> SumoSet:
         count += len(flows)
         files[name] = compressed_like(files[name], xml_bytes(
             root, f"{name}: every flow at vehsPerHour = {number_text(rate)} (cosim study)"))
-    if not count:
-        raise ConfigError(f"{sumo.config}: vehicles_per_hour: no <flow> in its route or additional files "
-                          f"({', '.join(sumo.demand_files) or 'none'}); the rate sets flows only")
+    if count:
+        return sumo.with_files(files)
+    vehicles, first, last = 0, math.inf, -math.inf
+    for name in sumo.demand_files:
+        part = _scan_demand(decompressed(files[name], name), name)
+        vehicles += part.vehicles
+        if part.departures is not None:
+            first, last = min(first, part.departures[0]), max(last, part.departures[1])
+    if vehicles < 2 or not last > first:
+        raise ConfigError(f"{sumo.config}: vehicles_per_hour: no <flow> and no vehicles departing over a time span "
+                          f"in its route or additional files ({', '.join(sumo.demand_files) or 'none'})")
+    now = vehicles / ((last - first) / 3600.0)
+    scale = rate / now
+    root = parse_xml(files[sumo.config], sumo.config)
+    for section in root:
+        for old in [e for e in section if e.tag == "scale"]:
+            section.remove(old)
+    processing = next((e for e in root if e.tag == "processing"), None)
+    if processing is None:
+        processing = ET.SubElement(root, "processing")
+    ET.SubElement(processing, "scale", value=repr(scale))
+    files[sumo.config] = xml_bytes(
+        root, f"{sumo.config}: the demand ({vehicles} vehicles, {now:.6g} per hour) scaled to "
+              f"{number_text(rate)} per hour (cosim study)")
     return sumo.with_files(files)
 
 

@@ -14,7 +14,6 @@ import signal
 import subprocess
 import sys
 import time
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -355,12 +354,6 @@ def test_outputs_are_written_whole_or_not_at_all(tmp_path: Path) -> None:
         with atomic_write(blocked, "CSV") as partial:
             partial.write_text("whole\n")
     assert sorted(p.name for p in (tmp_path / "new").iterdir()) == ["folder.csv", "out.csv"]
-
-
-def test_the_foxglove_layout_ships_with_the_package() -> None:
-    layout = json.loads(resources.files("cosim").joinpath("foxglove_layout.json").read_text(encoding="utf-8"))
-    text = json.dumps(layout)
-    assert TOPIC_SENSORS in text and TOPIC_VEHICLES in text and "configById" in layout
 
 
 def test_the_bulk_message_path_writes_the_same_bytes_as_mcap() -> None:

@@ -13,7 +13,7 @@ import pytest
 from cosim.core.bridge import PointLoad
 from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings, simulate
-from cosim.core.vehicles import QuarterCar
+from cosim.core.vehicles import QuarterCar, TyreQuarterCar
 from cosim.errors import ConfigError, SumoError
 from cosim.run.scenario import load_scenario
 from cosim.sumo import (
@@ -137,20 +137,35 @@ def test_sumo_errors_are_reported_clearly(tmp_path):
         SumoTraffic(tmp_path / "missing.sumocfg", AXIS)
     broken = tmp_path / "broken.sumocfg"
     broken.write_text("<configuration><input><net-file value='nope.net.xml'/></input></configuration>")
-    with pytest.raises(SumoError, match="could not load"):
+    with pytest.raises(ConfigError, match=r"broken\.sumocfg: net-file: cannot read .*nope\.net\.xml"):
         SumoTraffic(broken, AXIS).start()
-    with pytest.raises(SumoError, match="no edge"):
+    # A config cosim can read but SUMO cannot load: SUMO's own first error line, not libsumo's "Process Error".
+    shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
+    (tmp_path / "bad.rou.xml").write_text('<routes><vehicle id="v" depart="0"><route edges="nowhere"/></vehicle>'
+                                         '</routes>')
+    unknown = tmp_path / "unknown.sumocfg"
+    unknown.write_text('<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/>'
+                       '</input></configuration>')
+    with pytest.raises(SumoError, match=r"SUMO could not load it: .*nowhere"):
+        SumoTraffic(unknown, AXIS).start()
+    with pytest.raises(SumoError, match="has no edge 'no_such_edge'"):
         SumoTraffic(bundled_networks() / "light.sumocfg", AXIS, edges=("no_such_edge",)).start()
-    with pytest.raises(SumoError, match="no edge of the network lies on the bridge"):
+    with pytest.raises(SumoError, match="no lane of the network lies on the bridge"):
         SumoTraffic(bundled_networks() / "light.sumocfg", BridgeAxis((0.0, 500.0), (40.0, 500.0)), half_width=6).start()
 
 
 def test_vtype_parameters_become_quarter_cars():
-    car = model_from_parameters("car", 1500.0, "passenger", {"cosim.m_w": "150", "cosim.k_v": "76750", "cosim.c_v": "6110"})
+    car = model_from_parameters("car", 1500.0, "passenger",
+                                {"cosim.m_w": "150", "cosim.k_v": "76750", "cosim.c_v": "6110"})
     assert isinstance(car, QuarterCar) and car.m_v == 1350.0 and car.total_mass == 1500.0
-    default = model_from_parameters("lorry", 20000.0, "truck", {})
-    # vClass default: 1.8 Hz body bounce, 20 % damping, 12 % unsprung.
-    assert default.body_frequency_hz == pytest.approx(1.8) and default.m_w == pytest.approx(2400.0)
+    lorry = model_from_parameters("lorry", 20000.0, "truck", {})
+    # A truck's library suspension at the vType's mass: the limits of a "road-friendly" suspension,
+    # Council Directive 96/53/EC Annex III: body bounce 2.0 Hz (on a rigid tyre), 20 % damping; 10 % unsprung.
+    assert isinstance(lorry, TyreQuarterCar) and lorry.total_mass == pytest.approx(20000.0)
+    assert np.sqrt(lorry.k_v / lorry.m_v) / (2 * np.pi) == pytest.approx(2.0, rel=1e-12)
+    assert lorry.c_v / (2 * np.sqrt(lorry.k_v * lorry.m_v)) == pytest.approx(0.20, rel=1e-12)
+    assert lorry.m_w == pytest.approx(2000.0) and np.sqrt((lorry.k_v + lorry.k_t) / lorry.m_w) / (2 * np.pi) == \
+        pytest.approx(10.0, rel=1e-12)
     with pytest.raises(SumoError, match="vType bad: param `cosim.k_v` must be a number"):
         model_from_parameters("bad", 1500.0, "passenger", {"cosim.k_v": "stiff"})
     with pytest.raises(SumoError, match="leaves no body mass"):
@@ -339,17 +354,41 @@ def test_cli_runs_sumo_traffic_and_replays_it_bit_for_bit(tmp_path):
         assert attached[f"sumo/{name}"] == (bundled_networks() / name).read_bytes(), name
 
 
-def test_cli_reports_a_broken_sumo_config_before_writing_anything(tmp_path):
+def test_cli_reports_a_broken_sumo_config_before_writing_anything(tmp_path, capsys, monkeypatch):
+    from cosim.cli import main
+
+    monkeypatch.chdir(tmp_path)
     (tmp_path / "broken.sumocfg").write_text("<configuration><input><net-file value='missing.net.xml'/>"
                                              "</input></configuration>")
     (tmp_path / "s.toml").write_text(SCENARIO.format(config="broken.sumocfg", end=30.0))
-    run = cosim("run", "s.toml", "--out", "a.mcap", "--quiet", cwd=tmp_path)
-    assert run.returncode == 2
-    assert "Traceback" not in run.stderr and "SUMO could not load it" in run.stderr
-    assert not (tmp_path / "a.mcap").exists()  # SUMO starts before the log: exit 2, nothing written
+    assert main(["run", "s.toml", "--out", "a.mcap", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "missing.net.xml: cannot read the network" in err
+    assert not (tmp_path / "a.mcap").exists()
 
 
-def test_cli_rejects_a_vtype_with_impossible_parameters_before_the_run(tmp_path):
+def test_cli_reports_a_config_sumo_cannot_load_before_writing_anything(tmp_path, capsys, monkeypatch):
+    """cosim reads the files, SUMO rejects them (a route over an edge the network lacks): SUMO's own reason in
+    one line, exit 2, and no log: SUMO is started before the log is created (issue 10)."""
+    from cosim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
+    (tmp_path / "bad.rou.xml").write_text('<routes><vehicle id="v" depart="0"><route edges="nowhere"/></vehicle>'
+                                         '</routes>')
+    (tmp_path / "bad.sumocfg").write_text('<configuration><input><net-file value="bridge.net.xml"/>'
+                                          '<route-files value="bad.rou.xml"/></input></configuration>')
+    (tmp_path / "s.toml").write_text(SCENARIO.format(config="bad.sumocfg", end=30.0))
+    assert main(["run", "s.toml", "--out", "a.mcap", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "SUMO could not load it" in err and "nowhere" in err
+    assert not (tmp_path / "a.mcap").exists()
+
+
+def test_cli_rejects_a_vtype_with_impossible_parameters_before_the_run(tmp_path, capsys, monkeypatch):
+    from cosim.cli import main
+
+    monkeypatch.chdir(tmp_path)
     shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
     (tmp_path / "bad.rou.xml").write_text(
         '<routes><vType id="lorry" vClass="truck" mass="20000"><param key="cosim.k_v" value="stiff"/></vType>'
@@ -358,6 +397,7 @@ def test_cli_rejects_a_vtype_with_impossible_parameters_before_the_run(tmp_path)
         '<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/></input>'
         '</configuration>')
     (tmp_path / "s.toml").write_text(SCENARIO.format(config="bad.sumocfg", end=30.0))
-    run = cosim("run", "s.toml", "--out", "a.mcap", "--quiet", cwd=tmp_path)
-    assert run.returncode == 2 and "Traceback" not in run.stderr
-    assert "vType lorry: param `cosim.k_v` must be a number" in run.stderr
+    assert main(["run", "s.toml", "--out", "a.mcap", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "bad.rou.xml: vType lorry: param `cosim.k_v` must be a number" in err and err.count("\n") == 1
+    assert not (tmp_path / "a.mcap").exists()  # read from the demand files before anything is written

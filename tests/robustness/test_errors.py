@@ -111,12 +111,12 @@ def test_crafted_message_contents_are_one_line_for_every_reader(profiled_log: Pa
 
 
 SUMO_CASES = {
-    "broken network": ("bridge.net.xml", lambda t: t[:3000], "SUMO could not load it: unexpected end of input"),
+    "broken network": ("bridge.net.xml", lambda t: t[:3000], "bridge.net.xml: not a readable SUMO network"),
     "unknown vType": ("light.rou.xml", lambda t: t.replace('type="mix"', 'type="nosuchtype"', 1),
                       "SUMO could not load it"),
     "impossible cosim values": ("vtypes.add.xml", lambda t: t.replace('key="cosim.m_w" value="150"',
                                                                      'key="cosim.m_w" value="150000"', 1),
-                                "vType car: `cosim.m_w` = 150000.0 kg leaves no body mass"),
+                                "vType car: `cosim.m_w` = 150000 kg leaves no body mass"),
 }
 
 
@@ -126,7 +126,7 @@ def test_sumo_start_up_errors_write_nothing(tmp_path: Path, case: str) -> None:
     text = SUMO_SCENARIO.format(end=20.0)
     if case == "missing bridge edges":
         text = text.replace("seed = 3\n", 'seed = 3\nedges = ["bridge_e", "nowhere"]\n')
-        fragment = "the network has no edge(s) nowhere"
+        fragment = "traffic.edges: the network bridge.net.xml has no edge 'nowhere'"
     else:
         name, change, fragment = SUMO_CASES[case]
         (folder / name).write_text(change((folder / name).read_text()))
@@ -169,9 +169,8 @@ def test_a_study_refuses_the_folder_of_another_study(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("old, new, fragment", [
-    ('key="cosim.k_v"', 'key="cosim.kv"', "vType car: param `cosim.kv` is not a cosim param; did you mean "
-                                          "`cosim.k_v`?"),
-    ('key="cosim.model"', 'key="cosim.modle"', "param `cosim.modle` is not a cosim param; did you mean `cosim.model`?"),
+    ('key="cosim.k_v"', 'key="cosim.kv"', "vType car: unknown param `cosim.kv` (did you mean `cosim.k_v`?"),
+    ('key="cosim.model"', 'key="cosim.modle"', "vType car: unknown param `cosim.modle` (did you mean `cosim.model`?"),
     ('<param key="cosim.m_w" value="150"/>', '<param key="cosim.m_w" value="150"/><param key="cosim.k_t" value="1e6"/>',
      "vType car: param `cosim.k_t` is not used by model quarter-car"),
 ])

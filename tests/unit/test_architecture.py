@@ -2,7 +2,8 @@
 
 Layers, from the bottom: ``cosim.errors``; the numerical core ``cosim.core``
 (numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo`` and
-``cosim.log`` and the drawing module ``cosim.plots``; orchestration
+``cosim.log``, the drawing module ``cosim.plots`` and the engineering analyses
+``cosim.analysis`` (fatigue, extremes); orchestration
 ``cosim.run``; ``cosim.study`` and ``cosim.validation`` on top of it; the
 scenario-testing API ``cosim.testing``; the command line ``cosim.cli``.
 Dependencies point down only, modules of one layer do not import each other
@@ -30,9 +31,11 @@ LAYERS = {
     "cosim.sumo": 2,
     "cosim.log": 2,
     "cosim.plots": 2,
+    "cosim.analysis": 2,
     "cosim.run": 3,
     "cosim.study": 4,
     "cosim.validation": 4,
+    "cosim.dataset": 4,
     "cosim.testing": 5,
     "cosim.cli": 6,
     "cosim.__main__": 7,

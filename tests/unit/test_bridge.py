@@ -110,3 +110,19 @@ def test_model_is_immutable():
     bridge = build_bridge([10.0], 4, MAT, SEC, ["pinned", "fork"])
     with pytest.raises(AttributeError):
         bridge.alpha = 1.0  # type: ignore[misc]
+
+
+def test_stiffness_factors_and_support_springs_change_the_frequencies_as_closed_forms_say():
+    build = build_bridge
+    healthy = build([20.0], 20, MAT, SEC, ["pinned", "fork"])
+    uniform = build([20.0], 20, MAT, SEC, ["pinned", "fork"], stiffness_factors=[0.64] * 20)
+    # K scaled by 0.64 everywhere with M unchanged: every frequency scales by sqrt(0.64) = 0.8 exactly.
+    f0, f1 = healthy.modes(6).f_hz, uniform.modes(6).f_hz
+    np.testing.assert_allclose(f1, 0.8 * f0, rtol=1e-9)
+    local = build([20.0], 20, MAT, SEC, ["pinned", "fork"], stiffness_factors=[1.0] * 9 + [0.5] * 2 + [1.0] * 9)
+    assert local.modes(1).f_hz[0] < f0[0]  # less stiffness at mid-span: a lower first frequency
+    # A very stiff spring replacing a held DOF changes nothing; a soft one lowers the frequency.
+    stiff = build([20.0], 20, MAT, SEC, ["pinned", "fork"], support_springs=[(1, "w", 1e16)])
+    soft = build([20.0], 20, MAT, SEC, ["pinned", "fork"], support_springs=[(1, "w", 1e6)])
+    assert stiff.modes(1).f_hz[0] == pytest.approx(f0[0], rel=1e-6)
+    assert soft.modes(1).f_hz[0] < 0.99 * f0[0]

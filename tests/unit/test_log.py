@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from typing import Any
 
 import jsonschema
@@ -25,6 +26,8 @@ from cosim.log import (
     file_is_complete,
     read_log,
 )
+from cosim.log.scene import SceneWriter, plan_scene, scene_sensors
+from cosim.log.schemas import TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM
 
 MAT = Material(E=33e9, G=13.75e9, rho=2500.0)
 SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_s=0.0, z_s=0.0,
@@ -42,16 +45,23 @@ def schema_validator(text: bytes, cache: dict[bytes, Any]) -> Any:
     return cache[text]
 
 
-def _logged_run(path, duration=2.0, **kwargs):
+def _logged_run(path, duration=2.0, scene=False, **kwargs):
+    """Two quarter-cars over a 30 m span, logged (with the 3D scene and its hidden sensors if ``scene``)."""
     bridge = build_bridge([30.0], 10, MAT, SEC, ["rigid-end", "rigid-end"])
     cars = (ScriptedVehicle("a", QuarterCar(1e4, 1e3, 4e5, 2e4), 3.0, 20.0),
             ScriptedVehicle("b", QuarterCar(2e4, 2e3, 8e5, 4e4), -3.0, 15.0, entry_time=0.3, direction=-1))
     names = [s.name for s in SENSORS]
-    with LogRecorder(path, names, **kwargs) as rec, BlockLogger(rec, names, duration) as logger:
-        rec.attach("scenario.toml", "# test\n")
-        rec.status(0.0, "started")
-        result = simulate(bridge, ScriptedTraffic(cars, 30.0), duration, SolverSettings(dt=0.005), SENSORS,
-                          output_every=2, observers=[logger])
+    plan = plan_scene(bridge, SENSORS, 0.005, paths=[3.0, -3.0], taken=names) if scene else None
+    with LogRecorder(path, names, scene=scene, **kwargs) as rec:
+        writer = SceneWriter(rec, plan, len(names)) if plan is not None else None
+        if writer is not None:
+            writer.start()
+        with BlockLogger(rec, names, duration, scene=writer) as logger:
+            rec.attach("scenario.toml", "# test\n")
+            rec.status(0.0, "started")
+            result = simulate(bridge, ScriptedTraffic(cars, 30.0), duration, SolverSettings(dt=0.005),
+                              [*SENSORS, *(scene_sensors(plan) if plan is not None else [])],
+                              output_every=2, observers=[logger])
     return result
 
 
@@ -78,16 +88,87 @@ def test_every_message_validates_against_its_schema(tmp_path):
     from mcap.reader import make_reader
 
     path = tmp_path / "run.mcap"
-    _logged_run(path)
+    _logged_run(path, scene=True)
     with open(path, "rb") as fh:
         reader = make_reader(fh, validate_crcs=True)
         validators: dict[bytes, Any] = {}
-        count = 0
+        counts: dict[str, int] = {}
         for schema, channel, message in reader.iter_messages():
             assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
+            stored = json.loads(schema.data)
+            assert stored["title"] == schema.name and foxglove_problems(stored) == [], channel.topic
             schema_validator(schema.data, validators).validate(json.loads(message.data))
-            count += 1
-    assert count > 100
+            counts[channel.topic] = counts.get(channel.topic, 0) + 1
+    assert counts[TOPIC_SENSORS] > 100
+    # the scene: at t = 0 and every 0.1 s; the static part and the transform once
+    assert counts[TOPIC_SCENE] == 21 and counts[TOPIC_SCENE_STATIC] == counts[TOPIC_SCENE_TRANSFORM] == 1
+    assert read_log(path).topic(TOPIC_SCENE)  # and cosim's reader checks them against its own schemas
+
+
+# --------------------------------------------------------------------------- Foxglove
+
+#: The JSON types Foxglove's JSON-Schema parser turns into fields (studio-base 1.48's parseJsonSchema, the same
+#: code in Lichtblick): a property without one (an ``enum`` alone) drops the whole channel with
+#: "Unsupported type undefined for <field>", and arrays of arrays are not supported.
+FOXGLOVE_TYPES = {"boolean", "string", "number", "integer", "object", "array"}
+
+
+def foxglove_problems(schema: dict[str, Any], where: str = "") -> list[str]:
+    """What Foxglove would reject in a message schema: every property needs a type it knows, objects are
+    walked, an array's items need a type too (not another array)."""
+    if schema.get("type") != "object":
+        return [f"{where or 'the message'}: expected type object, got {schema.get('type')!r}"]
+    problems = []
+    for name, prop in schema.get("properties", {}).items():
+        here = f"{where}.{name}" if where else name
+        kind = prop.get("type")
+        if kind not in FOXGLOVE_TYPES:
+            problems.append(f"{here}: type {kind!r}")
+        elif kind == "object":
+            problems += foxglove_problems(prop, here)
+        elif kind == "array":
+            item = prop.get("items", {})
+            if item.get("type") not in FOXGLOVE_TYPES - {"array"}:
+                problems.append(f"{here}[]: item type {item.get('type')!r}")
+            elif item["type"] == "object":
+                problems += foxglove_problems(item, here + "[]")
+    return problems
+
+
+def test_every_schema_is_one_foxglove_accepts():
+    from cosim.log.schemas import topic_schemas
+
+    schemas = topic_schemas(["node1", "node.2", "t_2"], scene=True)
+    assert {topic for topic, _ in schemas} >= {TOPIC_EVENTS, TOPIC_STATUS, TOPIC_SCENE, TOPIC_SCENE_TRANSFORM}
+    for topic, schema in schemas:
+        assert foxglove_problems(schema) == [], topic
+    # The check fails where Foxglove failed: the schemas of logs written before this version (enum alone).
+    old_events = {"type": "object", "properties": {"t": {"type": "number"}, "event": {"enum": ["entered"]}}}
+    assert foxglove_problems(old_events) == ["event: type None"]
+    nested = {"type": "object", "properties": {"a": {"type": "array", "items": {"type": "array"}}}}
+    assert foxglove_problems(nested) == ["a[]: item type 'array'"]
+    # The 3D panel recognises the scene by its schema's name.
+    titles = {topic: schema["title"] for topic, schema in schemas}
+    assert titles[TOPIC_SCENE] == titles[TOPIC_SCENE_STATIC] == "foxglove.SceneUpdate"
+    assert titles[TOPIC_SCENE_TRANSFORM] == "foxglove.FrameTransform"
+
+
+@pytest.mark.parametrize("name", ["paper-double-tee", "paper-bridge-traffic"])
+def test_logs_written_before_the_schemas_had_types_still_read(name):
+    """A scripted and a SUMO log written by an earlier version: every message checked against today's schemas."""
+    from mcap.reader import make_reader
+
+    from cosim.log import open_log
+
+    path = Path(__file__).resolve().parents[1] / "regression" / "logs" / f"{name}.mcap"
+    with open(path, "rb") as fh:
+        summary = make_reader(fh).get_summary()
+    stored = {c.topic: json.loads(summary.schemas[c.schema_id].data) for c in summary.channels.values()}
+    assert "type" not in stored[TOPIC_EVENTS]["properties"]["event"]  # written before this change
+    whole = read_log(path)
+    assert not whole.truncated and whole.final_status["state"] == "finished"
+    assert {topic: len(m) for topic, m in whole.messages.items()} == open_log(path).counts
+    assert {e["event"] for e in whole.topic(TOPIC_EVENTS)} >= {"entered", "left"}
 
 
 def test_an_exception_leaves_a_finished_log_that_says_why(tmp_path):
@@ -136,7 +217,8 @@ def test_vehicle_messages_carry_the_contact_forces(tmp_path):
     frames = read_log(path).topic(TOPIC_VEHICLES)
     forces = [v["contact_force"] for f in frames for v in f["vehicles"] if v["id"] == "a"]
     expected = result.vehicle("a")["contact_force"]
-    np.testing.assert_array_equal(np.array(forces), expected[np.isin(result.vehicle("a")["t"], [f["t"] for f in frames])])
+    logged = np.isin(result.vehicle("a")["t"], [f["t"] for f in frames])
+    np.testing.assert_array_equal(np.array(forces), expected[logged])
     assert len(read_log(path).topic(TOPIC_STATUS)) >= 2
 
 
