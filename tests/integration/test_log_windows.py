@@ -115,20 +115,24 @@ def test_a_window_exports_exactly_the_rows_of_the_whole_export_in_it(slow_log: P
 def test_a_window_reads_only_the_chunks_that_overlap_it(slow_log: Path, chunk_index, tmp_path: Path
                                                         ) -> None:  # noqa: ANN001
     chunks, ids = chunk_index
+
+    def overlapping(topic: str, start: float, end: float | None) -> list:
+        """The reference: the mcap package's chunk index, chunks with this topic overlapping the window."""
+        lo, hi = to_ns(start), (to_ns(end) if end is not None else 1 << 64)
+        return [c for c in chunks if c.message_end_time >= lo and c.message_start_time <= hi
+                and ids[topic] in c.message_index_offsets]
+
     for topic in (TOPIC_SENSORS, TOPIC_EVENTS):
         for start, end in [(10.0, 12.5), (0.0, 0.5), (37.0, None)]:
-            lo, hi = to_ns(start), (to_ns(end) if end is not None else 1 << 64)
-            # The reference: the mcap package's chunk index, chunks with this topic overlapping the window.
-            overlapping = [c for c in chunks if c.message_end_time >= lo and c.message_start_time <= hi
-                           and ids[topic] in c.message_index_offsets]
             stats = ReadStats()
             messages = list(iter_messages(slow_log, [topic], start, end, stats))
-            assert stats.chunks == len(overlapping) and stats.messages == len(messages), (topic, start, end)
-    assert len(overlapping) <= 3 < len(chunks)  # the last window: 3 s of 40
+            assert stats.chunks == len(overlapping(topic, start, end)) and stats.messages == len(messages), \
+                (topic, start, end)
+    assert 0 < len(overlapping(TOPIC_SENSORS, 10.0, 12.5)) <= len(chunks) // 4  # 2.5 s of 40
     stats = ReadStats()
     rows, _ = export_csv(slow_log, tmp_path / "w.csv", start=10.0, end=12.5, stats=stats)
     # What export reads: the chunk of the final status (open_log's summary), then the window's chunks.
-    assert stats.chunks == 1 + 3 and stats.messages == rows == 1251
+    assert stats.chunks == 1 + len(overlapping(TOPIC_SENSORS, 10.0, 12.5)) and stats.messages == rows == 1251
     stats = ReadStats()
     export_csv(slow_log, tmp_path / "all.csv", stats=stats)
     assert stats.chunks == 1 + len(chunks)  # without a window every chunk is read (and every checksum checked)
@@ -348,3 +352,28 @@ def test_a_log_rewritten_by_the_mcap_package_is_windowed_through_its_index(slow_
     assert result.returncode == 0, result.stderr
     header, *rows = whole_exports[TOPIC_SENSORS]
     assert (tmp_path / "w.csv").read_bytes() == header + b"".join(r for r in rows if inside(r, 10.0, 12.5))
+
+
+def test_info_lists_the_sumo_vehicles_of_a_long_log_from_its_start_unless_verify(tmp_path: Path,
+                                                                                 monkeypatch: pytest.MonkeyPatch
+                                                                                 ) -> None:
+    """The vehicles come from the "entered" events: all of them with --verify, those of the first
+    ``EVENT_CHUNKS`` chunks without (lowered here so that 2 min of SUMO traffic count as long)."""
+    from cosim.cli import logs
+    from cosim.run.scenario import load_scenario
+
+    text = load_scenario("paper-bridge-traffic").text.replace("end = 600.0 ", "end = 120.0 ", 1)
+    (tmp_path / "sumo.toml").write_text(text.replace('name = "paper-bridge-traffic"', 'name = "two-minutes"', 1))
+    result = cosim_cli("run", "sumo.toml", "--out", "sumo.mcap", "--quiet", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    log = tmp_path / "sumo.mcap"
+    full = cosim_cli("info", "--verify", str(log)).stdout
+    whole = next(line for line in full.splitlines() if line.startswith("Vehicles (SUMO, "))
+    assert cosim_cli("info", str(log)).stdout.count(whole) == 1  # a short log: every chunk within the budget
+    vehicles = int(whole.split()[2])
+    monkeypatch.setattr(logs, "EVENT_CHUNKS", 3)
+    fast = cosim_cli("info", str(log)).stdout
+    start = next(line for line in fast.splitlines() if line.startswith("Vehicles (SUMO, "))
+    assert " on the deck in its first " in start and "s (--verify: the whole log)" in start, start
+    assert 0 < int(start.split()[2]) < vehicles
+    assert full.replace(whole, "").splitlines()[:-1] == fast.replace(start, "").splitlines()[:-1]  # all else alike
