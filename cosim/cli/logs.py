@@ -45,8 +45,8 @@ def cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def checked_line(o: LogOverview) -> str:
-    """What ``cosim info`` verified, and what it did not."""
+def checked_line(o: LogOverview, extra_chunks: int = 0) -> str:
+    """What ``cosim info`` verified, and what it did not (``extra_chunks``: read after ``o``, e.g. for events)."""
     if not o.complete:
         return (f"Checked: the {o.chunks} complete chunk(s) decompressed and their checksums verified "
                 "(a file cut short has no summary or file checksum)")
@@ -58,7 +58,8 @@ def checked_line(o: LogOverview) -> str:
                 f"summary's and the attachments'{older}; counts from the messages{agree}")
     file = "the file (every byte as written), " if o.data_checksum else ""
     unread = "" if o.data_checksum else ", the others not read"
-    return (f"Checked: checksums of {file}the summary and the attachments; {o.chunks_read} of {o.chunks} chunks "
+    read = min(o.chunks_read + extra_chunks, o.chunks)
+    return (f"Checked: checksums of {file}the summary and the attachments; {read} of {o.chunks} chunks "
             f"decompressed{unread}{older}; counts from the summary (--verify: every chunk)")
 
 
@@ -87,8 +88,10 @@ def info_lines(o: LogOverview) -> list[str]:
         lines.append(f"Simulated: {fmt_g(o.end_time, 6)} s")
     sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
     lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
+    extra_chunks = 0
     if o.counts.get(TOPIC_TRAFFIC) or info.get("traffic") == "sumo":
-        lines.extend(_sumo_vehicle_lines(o))
+        vehicle_lines, extra_chunks = _sumo_vehicle_lines(o)
+        lines.extend(vehicle_lines)
     elif "vehicles" in info:
         try:
             vehicles = json.loads(info["vehicles"])
@@ -112,7 +115,7 @@ def info_lines(o: LogOverview) -> list[str]:
                      "it is read up to its last complete chunk")
     atts = ", ".join(f"{name} ({size_text(len(data))})" for name, data in o.attachments.items()) or "none"
     lines.append(f"Attachments: {atts}")
-    lines.append(checked_line(o))
+    lines.append(checked_line(o, extra_chunks))
     return lines
 
 
@@ -122,8 +125,9 @@ SHOWN_VEHICLES = 20
 EVENT_CHUNKS = 256
 
 
-def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
-    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run.
+def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
+    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run,
+    and the chunks read for them.
 
     Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
     thousands): the vehicles of a long log are those of its start, and the line says so.
@@ -148,8 +152,8 @@ def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
     shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"
                                                     if len(vehicles) > SHOWN_VEHICLES else "")
     axle_text = f", {len(axles)} axles" if len(axles) != len(vehicles) else ""
-    when = f" in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
-    lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{when}{axle_text}): {shown or 'none'}"]
+    when = f", in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
+    lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{axle_text}{when}): {shown or 'none'}"]
     raw = o.attachments.get(VEHICLE_TYPES_ATTACHMENT)
     if raw is not None:
         try:
@@ -159,7 +163,7 @@ def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
             lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
-    return lines
+    return lines, stats.chunks
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
