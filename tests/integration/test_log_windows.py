@@ -374,6 +374,6 @@ def test_info_lists_the_sumo_vehicles_of_a_long_log_from_its_start_unless_verify
     monkeypatch.setattr(logs, "EVENT_CHUNKS", 3)
     fast = cosim_cli("info", str(log)).stdout
     start = next(line for line in fast.splitlines() if line.startswith("Vehicles (SUMO, "))
-    assert " on the deck in its first " in start and "s (--verify: the whole log)" in start, start
+    assert ", in its first " in start and " s (--verify: the whole log)): " in start, start
     assert 0 < int(start.split()[2]) < vehicles
     assert full.replace(whole, "").splitlines()[:-1] == fast.replace(start, "").splitlines()[:-1]  # all else alike
