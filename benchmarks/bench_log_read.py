@@ -71,8 +71,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{name}: {wall:.2f} s, {peak:.0f} MB  ({last[:100]})", flush=True)
             rows.append((name, wall, peak))
     lines = [
-        f"# Reading a {overview.end_time - overview.start_time:g} s log ({overview.size / 1e6:.0f} MB, "
-        f"{overview.chunks} chunks)",
+        f"# Reading a log of {overview.end_time - overview.start_time:g} s: scenario "
+        f"{overview.info.get('scenario', '?')} ({overview.info.get('basis', '?')} basis), "
+        f"{overview.size / 1e6:.0f} MB, {overview.chunks} chunks",
         "",
         f"{datetime.datetime.now():%Y-%m-%d %H:%M}, {platform.processor() or platform.machine()}, "
         f"{os.cpu_count()} cores, Python {platform.python_version()}; load average before: {os.getloadavg()[0]:.2f}. "
