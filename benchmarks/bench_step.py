@@ -48,9 +48,9 @@ import math
 import platform
 import sys
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
 
 import numpy as np
 import scipy
@@ -96,7 +96,7 @@ class Settings:
     elements: tuple[int, ...]
 
     @classmethod
-    def make(cls, quick: bool, reps: int) -> "Settings":
+    def make(cls, quick: bool, reps: int) -> Settings:
         if quick:
             return cls(True, reps, 500, 60, 400, 150, (0, 1, 4, 8, 16, 64), (20, 40, 80))
         return cls(False, reps, 2000, 300, 2000, 1000, (0, 1, 4, 8, 16, 64), (20, 40, 80, 160))

@@ -124,7 +124,7 @@ def main() -> int:
         "| how | wall time [s] | speed-up vs one after another |",
         "|---|---:|---:|",
     ]
-    for label, workers, wall, run_sum, _ in results:
+    for label, _workers, wall, _run_sum, _ in results:
         lines.append(f"| {label} | {wall:.2f} | {base / wall:.2f} |")
     lines += ["", f"Rows identical whatever the number of workers (wall times aside): {'yes' if identical else 'NO'}"]
     overhead = results[1][2] - results[0][2]

@@ -43,7 +43,8 @@ sensors = [Sensor("n1", 20, 0.0), Sensor("n2", 20, 6.655), Sensor("n3", 20, 3.32
 basis = mode.split("+")[0]
 # Compile (or load) the kernels outside the timed part.
 from cosim.core.traffic import ScriptedTraffic
-simulate(bridge, ScriptedTraffic((), 40.0), 0.01, SolverSettings(dt=0.005, basis=basis if basis != "sumo" else "direct", modes=30), sensors)
+warm = SolverSettings(dt=0.005, basis=basis if basis != "sumo" else "direct", modes=30)
+simulate(bridge, ScriptedTraffic((), 40.0), 0.01, warm, sensors)
 started = time.perf_counter()
 vehicles = max_on = 0
 if mode == "sumo":
@@ -59,7 +60,8 @@ else:
         path = Path(tempfile.mkdtemp()) / "run.mcap"
         names = [s.name for s in sensors]
         with LogRecorder(path, names) as rec, BlockLogger(rec, names, duration) as lg:
-            with SumoTraffic(cfg, axis, step=0.05, end=duration + 1, half_width=6.655, frame_sink=TrafficLogger(rec)) as tr:
+            with SumoTraffic(cfg, axis, step=0.05, end=duration + 1, half_width=6.655,
+                             frame_sink=TrafficLogger(rec)) as tr:
                 res = simulate(bridge, tr, duration, solver, sensors, output_every=2, observers=[lg], collect=False)
     else:
         with SumoTraffic(cfg, axis, step=0.05, end=duration + 1, half_width=6.655) as tr:

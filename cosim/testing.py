@@ -41,9 +41,10 @@ import os
 import shutil
 import sys
 import tempfile
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -183,7 +184,7 @@ def sensor(name: str, x: float, y: float = 0.0, quantity: str = "displacement") 
 
 def quarter_car(id: str, mass: float, y: float, speed: float, *, f_body: float = 1.5, zeta: float = 0.1,
                 wheel_share: float = 0.1, entry_time: float = 0.0, direction: str = "+x") -> dict[str, Any]:
-    """A ``[[vehicles]]`` quarter-car of gross ``mass`` (kg) with body bounce ``f_body`` (Hz) and damping ratio ``zeta``.
+    """A ``[[vehicles]]`` quarter-car of gross ``mass`` (kg), body bounce ``f_body`` (Hz), damping ratio ``zeta``.
 
     ``wheel_share`` of the mass is the wheel (unsprung); the body is the rest.
     """

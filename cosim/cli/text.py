@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import sys
-from typing import Sequence
+from collections.abc import Sequence
 
 from cosim.core.bridge import BridgeModel, ModalResult
 from cosim.core.section import SectionProperties

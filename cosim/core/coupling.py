@@ -199,8 +199,10 @@ class CoupledSystem:
         rows = [sensor_row(bridge, s) for s in self.sensors]
         idx, vals = basis.sparse_rows(rows)
         order = np.array([TIME_DERIVATIVE[s.quantity] for s in self.sensors], dtype=np.int64)
+        every = np.array([s.every for s in self.sensors], dtype=np.int64)
+        self._step0 = np.zeros(1, dtype=np.int64)  # shared by both engines' rows, set before each block
         # The engines that solve this basis: name -> (arrays, sensor rows in its coordinates).
-        self._engines = {"basis": (basis.kernel_arrays(), kernels.SensorRows(idx, vals, order))}
+        self._engines = {"basis": (basis.kernel_arrays(), kernels.SensorRows(idx, vals, order, every, self._step0))}
         self._complete = basis.complete if isinstance(basis, DirectBasis) else None
         if self._complete is not None and isinstance(basis, DirectBasis):
             dense = np.array([basis.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows],
@@ -208,7 +210,8 @@ class CoupledSystem:
             modal_rows = dense @ self._complete.phi
             modal_idx = np.tile(np.arange(basis.n, dtype=np.int64), (len(rows), 1))
             self._engines["complete-modal"] = (basis.complete_kernel_arrays(),
-                                               kernels.SensorRows(modal_idx, modal_rows, order))
+                                               kernels.SensorRows(modal_idx, modal_rows, order, every,
+                                                                                  self._step0))
         self._engine = "basis"
 
     # ------------------------------------------------------------ bookkeeping
@@ -420,6 +423,7 @@ class CoupledSystem:
         few = self._complete is not None and q <= DirectBasis.COMPLETE_MODAL_MAX_VEHICLES
         self._switch_engine("complete-modal" if few else "basis")
         arrays, sensor_rows = self._engines[self._engine]
+        self._step0[0] = self.n_steps + 1  # row k of the block is step n_steps + 1 + k
         kernels.advance_block(arrays, self._deck, self._scheme, self._state, fleet, kin, sensor_rows, out,
                               self._groups)
         self.basis.n_solves = int(self._counters[2])

@@ -58,8 +58,10 @@ Fleet = namedtuple("Fleet", ["kind", "params", "weight", "vstate", "lifted"])
 #: Traffic over the block's K steps: contact point x, speed, acceleration along +x (K, q); lateral y (q);
 #: road r and its slope r_x under each wheel (K, q).
 Kinematics = namedtuple("Kinematics", ["x", "v", "a", "y", "r", "r_x"])
-#: Sensor rows in basis coordinates (s, nnz) and the time derivative each reads (0 d, 1 d', 2 d'').
-SensorRows = namedtuple("SensorRows", ["idx", "vals", "order"])
+#: Sensor rows in basis coordinates (s, nnz) and the time derivative each reads (0 d, 1 d', 2 d'');
+#: ``every`` (s,): read at the steps whose index is a multiple of it (NaN between); ``step0`` (1,): the index
+#: of the block's first step.
+SensorRows = namedtuple("SensorRows", ["idx", "vals", "order", "every", "step0"])
 #: Linear vehicles on tyres (cosim.core.vehicles.linear), each a group of consecutive contact columns.
 #: Per vehicle g: first column, contacts, DOFs; offsets into ``mats`` (Mv, Cv, Kv, contact rows b, body
 #: observation rows, flattened), ``state`` (z, z', z'', previous elastic forces) and ``aux`` (step scratch).
@@ -602,6 +604,10 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                         force[j] += rv[i, 0, kk] * weighted[i]
         _record(step, elems, contact, fleet, groups, out)
         for s_ in range(sensors.idx.shape[0]):
+            every = sensors.every[s_]
+            if every > 1 and (sensors.step0[0] + step) % every != 0:
+                out.sensors[step, s_] = np.nan
+                continue
             order = sensors.order[s_]
             src = d if order == 0 else (v if order == 1 else a)
             acc_ = 0.0

@@ -65,9 +65,12 @@ class Sensor:
         omega: the principal sectorial coordinate at (y, z), m^2 (docs/theory.md
             (1.3)), for a section given by constants with warping (``I_w > 0``),
             where cosim has no warping function; a section of plates computes it.
+        every: read only at the steps whose index from the run's start (t = 0) is a multiple
+            of ``every``, NaN at the others: a drawing that needs a few samples per second
+            (the log's 3D scene) then costs a few rows, not one per step.
 
     Raises:
-        ConfigError: an unknown quantity, a non-finite position, or z missing.
+        ConfigError: an unknown quantity, a non-finite position, z missing, or ``every`` not an integer >= 1.
     """
 
     name: str
@@ -76,8 +79,11 @@ class Sensor:
     quantity: str = "displacement"
     z: float | None = None
     omega: float | None = None
+    every: int = 1
 
     def __post_init__(self) -> None:
+        if isinstance(self.every, bool) or not isinstance(self.every, int) or self.every < 1:
+            raise ConfigError(f"sensor {self.name}: `every` must be an integer >= 1 (got {self.every!r})")
         if self.quantity not in SENSOR_QUANTITIES:
             raise ConfigError(f"sensor {self.name}: `quantity` must be one of {', '.join(SENSOR_QUANTITIES)} "
                               f"(got {self.quantity!r})")

@@ -184,8 +184,9 @@ class _Collector:
 class _Extremes:
     """Running extremes for summaries, in constant memory whatever the run's length."""
 
-    def __init__(self, names: Sequence[str]) -> None:
+    def __init__(self, names: Sequence[str], sparse: bool = False) -> None:
         self.names = list(names)
+        self.sparse = sparse  # some sensor is read only at some steps (NaN at the others)
         self.s_min = np.zeros(len(names))
         self.s_max = np.zeros(len(names))
         self.force: dict[str, list[float]] = {}
@@ -193,8 +194,13 @@ class _Extremes:
 
     def on_block(self, times, keep, report) -> None:
         if len(report.sensors):
-            self.s_min = np.minimum(self.s_min, report.sensors.min(axis=0))
-            self.s_max = np.maximum(self.s_max, report.sensors.max(axis=0))
+            values = report.sensors
+            low, high = values, values
+            if self.sparse:  # the steps a sensor was not read at do not count
+                unread = np.isnan(values)
+                low, high = np.where(unread, np.inf, values), np.where(unread, -np.inf, values)
+            self.s_min = np.minimum(self.s_min, low.min(axis=0))
+            self.s_max = np.maximum(self.s_max, high.max(axis=0))
         if not report.ids:
             return
         # Vehicles, not contact points: the axles of one vehicle ("id#k") count once.
@@ -292,7 +298,7 @@ def simulate(
                            sensors=tuple(sensors))
     n_steps = int(round(duration / solver.dt))
     collector = _Collector(len(sensors)) if collect else None
-    extremes = _Extremes([s.name for s in sensors])
+    extremes = _Extremes([s.name for s in sensors], sparse=any(s.every > 1 for s in sensors))
     watchers: list = [extremes] + ([collector] if collector else []) + list(observers)
     # A zero-step call compiles (or loads from cache) the kernel outside the timed run.
     empty = np.zeros((0, 0))

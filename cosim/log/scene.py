@@ -50,8 +50,8 @@ SCENE_RATE_HZ = 10.0
 #: The scene is on by default for runs of at most this long, s.
 SCENE_MAX_DURATION = 3600.0
 #: Deck segments per span (fewer when the span has fewer elements). Each station between supports costs two
-#: sensor rows at every step (on the paper bridge with the direct basis and few vehicles about 0.6 us each,
-#: a step costing about 13 us; docs/foxglove.md): the deck is drawn as a spline through a few stations.
+#: sensor rows, read only at the scenes' steps (``Sensor.every``): the deck is drawn as a spline through a few
+#: stations.
 SEGMENTS_PER_SPAN = 4
 #: Points drawn per segment between stations.
 DRAW_SUBDIVISIONS = 4
@@ -212,6 +212,7 @@ def plan_scene(bridge: BridgeModel, sensors: Sequence[Sensor], dt: float, *, exa
     """
     stations = _stations(bridge)
     y_min, y_max = (float(v) for v in bridge.section.deck_y)
+    every = max(1, int(round(1.0 / (SCENE_RATE_HZ * dt))))
     names = set(taken)
     prefix = _HIDDEN_PREFIX
     while any(n.startswith(prefix) for n in names):
@@ -222,7 +223,7 @@ def plan_scene(bridge: BridgeModel, sensors: Sequence[Sensor], dt: float, *, exa
     for i, x in enumerate(stations):
         pair = []
         for side, y in (("right", y_min), ("left", y_max)):
-            sensor = Sensor(f"{prefix}/{side}/{i}", x, y, "displacement")
+            sensor = Sensor(f"{prefix}/{side}/{i}", x, y, "displacement", every=every)  # read at scenes only
             row = sensor_row(bridge, sensor)
             values = np.abs(row.values[0])
             read = row.dofs[values > 1e-12 * max(float(values.max()), 1e-300)]  # shape-function round-off aside
@@ -237,7 +238,6 @@ def plan_scene(bridge: BridgeModel, sensors: Sequence[Sensor], dt: float, *, exa
         target = SAG_OF_SPAN * float(np.max(np.diff(bridge.support_x)))
         exaggeration = _nice(min(max(target / sag, 1.0), 1e6), up=False) if sag > 0 and math.isfinite(sag) else 1.0
     newton_per_m = _nice((reference_contact or REFERENCE_AXLE_N) / ARROW_LENGTH, up=True)
-    every = max(1, int(round(1.0 / (SCENE_RATE_HZ * dt))))
     axis = min(max(0.0, y_min), y_max)  # where a bending moment (of the whole section) is marked
     marks = tuple(SceneSensor(s.name, float(s.x), float(s.y) if s.quantity != "bending_moment" else axis,
                               s.quantity) for s in sensors)

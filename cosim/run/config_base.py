@@ -205,7 +205,8 @@ def _format_one(root: type[BaseModel], error: dict[str, Any]) -> list[tuple[str,
         key = str(loc[-1])
         listed = f"expected one of: {', '.join(allowed)}" if allowed else "no keys expected here"
         if len(loc) == 1 and key in FUTURE_SECTIONS:
-            return [(key_path(loc), f"not supported yet (planned for a later version: {FUTURE_SECTIONS[key]}; {listed})")]
+            return [(key_path(loc),
+                     f"not supported yet (planned for a later version: {FUTURE_SECTIONS[key]}; {listed})")]
         hint = suggest(key, allowed)
         hint_text = f'; did you mean "{hint}"?' if hint else ""
         return [(key_path(loc), f"unknown key{hint_text} ({listed})")]

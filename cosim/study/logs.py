@@ -6,7 +6,7 @@ complete (resume) by :mod:`cosim.study.execute` through these three functions.
 from __future__ import annotations
 
 import os
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

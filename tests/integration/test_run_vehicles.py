@@ -193,7 +193,8 @@ def test_interrupt_exits_130_with_a_finished_log(tmp_path: Path, monkeypatch: py
     out = tmp_path / "o.mcap"
     assert run_main(str(path), "--out", str(out)) == 130
     err = capsys.readouterr().err
-    assert err.splitlines()[-1] == (f"cosim: interrupted by SIGINT at about t = 1 s of 4 s; the log up to there is in {out} "
+    assert err.splitlines()[-1] == (f"cosim: interrupted by SIGINT at about t = 1 s of 4 s; the log up to there is in "
+                                    f"{out} "
                                     '(finished, status "interrupted")')
     log = read_log(out)
     assert not log.truncated and log.final_status["state"] == "interrupted"

@@ -98,8 +98,10 @@ def _twist(paper_bridge, cfg, duration=60.0):
 
 def test_mirrored_traffic_does_not_twist_and_one_direction_does(paper_bridge, tmp_path):
     both = TRUCK + (
-        '<vehicle id="e" type="t40" depart="0" departSpeed="15" departPos="0"><route edges="in_e pre_e bridge_e post_e out_e"/></vehicle>'
-        '<vehicle id="w" type="t40" depart="0" departSpeed="15" departPos="0"><route edges="in_w pre_w bridge_w post_w out_w"/></vehicle>'
+        '<vehicle id="e" type="t40" depart="0" departSpeed="15" departPos="0">'
+        '<route edges="in_e pre_e bridge_e post_e out_e"/></vehicle>'
+        '<vehicle id="w" type="t40" depart="0" departSpeed="15" departPos="0">'
+        '<route edges="in_w pre_w bridge_w post_w out_w"/></vehicle>'
     )
     (tmp_path / "a").mkdir()
     mirrored, res = _twist(paper_bridge, _config(tmp_path / "a", both))
@@ -107,7 +109,8 @@ def test_mirrored_traffic_does_not_twist_and_one_direction_does(paper_bridge, tm
     # Point-symmetric loads: the mid-span twist vanishes (to round-off of the SUMO positions).
     assert np.max(np.abs(mirrored)) < 1e-3 * np.max(np.abs(res.sensors["mid"])) / 6.0
     east = TRUCK + (
-        '<vehicle id="e" type="t40" depart="0" departSpeed="15" departPos="0"><route edges="in_e pre_e bridge_e post_e out_e"/></vehicle>'
+        '<vehicle id="e" type="t40" depart="0" departSpeed="15" departPos="0">'
+        '<route edges="in_e pre_e bridge_e post_e out_e"/></vehicle>'
     )
     (tmp_path / "b").mkdir()
     twist, _ = _twist(paper_bridge, _config(tmp_path / "b", east))

@@ -271,3 +271,27 @@ def test_overlapping_traffic_and_solver_gives_the_same_numbers():
     for name in ("mid", "acc"):
         np.testing.assert_array_equal(runs[0].sensors[name], runs[1].sensors[name])
     np.testing.assert_array_equal(runs[0].vehicle_table["contact_force"], runs[1].vehicle_table["contact_force"])
+
+
+@pytest.mark.parametrize("basis", ["direct", "modal"])
+def test_a_sensor_read_every_nth_step_is_the_same_numbers_at_those_steps(basis):
+    """Sensor(every=N) is read at the steps whose index is a multiple of N (NaN at the others), in both engines
+    and across blocks; its values there are the dense sensor's bit for bit (the same row, the same state)."""
+    bridge = _bridge()
+    cars = tuple(ScriptedVehicle(f"c{k}", QuarterCar(m_v=8000.0, m_w=900.0, k_v=4e5, c_v=3e4), 1.5 * (-1) ** k,
+                                 15.0 + k, entry_time=0.3 * k) for k in range(3))
+    dense, sparse = Sensor("mid", 15.0, 1.0), Sensor("mid_every_7", 15.0, 1.0, every=7)
+    acc = Sensor("acc_every_7", 10.0, -1.0, "acceleration", every=7)
+    solver = SolverSettings(dt=2e-3, basis=basis, modes=20 if basis == "modal" else None)
+    run = simulate(bridge, ScriptedTraffic(cars, 30.0), 3.0, solver,
+                   [dense, sparse, acc, Sensor("acc", 10.0, -1.0, "acceleration")], block_steps=50)
+    steps = np.rint(run.t / 2e-3).astype(int)
+    read = steps % 7 == 0
+    assert read.sum() == 1500 // 7 + 1 and np.all(np.isnan(run.sensors["mid_every_7"][~read]))
+    np.testing.assert_array_equal(run.sensors["mid_every_7"][read], run.sensors["mid"][read])
+    np.testing.assert_array_equal(run.sensors["acc_every_7"][read], run.sensors["acc"][read])
+    # The extremes count only the steps read: those of the dense sensor at the same steps.
+    assert run.sensor_min["mid_every_7"] == np.min(run.sensors["mid"][read])
+    assert run.sensor_max["acc_every_7"] == max(np.max(run.sensors["acc"][read]), 0.0)
+    with pytest.raises(ConfigError, match="sensor s: `every` must be an integer >= 1"):
+        Sensor("s", 1.0, every=0)

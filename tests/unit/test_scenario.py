@@ -781,7 +781,7 @@ def test_duration_without_vehicles_must_be_given() -> None:
     scenario = parse_scenario(CONSTANTS_TEXT, "static.toml")
     assert scenario.vehicles == () and scenario.leave_time is None
     with pytest.raises(ConfigError, match=r"^static.toml: solver.duration: required key is missing"):
-        scenario.duration
+        _ = scenario.duration
 
 
 def test_random_road_has_one_seeded_profile_per_wheel_path(tmp_path: Path) -> None:

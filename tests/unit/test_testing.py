@@ -68,7 +68,8 @@ def test_named_results_peaks_and_vehicles(girder):
     assert res.names == ["mid", "moment", "acc"] and "mid" in res and len(res["mid"]) == len(res.t)
     for name in res.names:  # logged at every step, so the peak over every step is the samples' peak
         assert ct.peak(res, name) == pytest.approx(np.max(np.abs(res[name])), rel=1e-12)
-        assert res.minimum(name) == pytest.approx(res[name].min()) and res.maximum(name) == pytest.approx(res[name].max())
+        assert res.minimum(name) == pytest.approx(res[name].min())
+        assert res.maximum(name) == pytest.approx(res[name].max())
     car = res.vehicle("car")
     assert set(car) >= {"t", "x", "speed", "contact_force", "body_acceleration"}
     assert np.allclose(car["speed"], 15.0) and car["x"][0] >= 0.0 and car["x"][-1] <= 40.0
