@@ -7,9 +7,9 @@ Subcommands (each in its module: :mod:`.run`, :mod:`.logs`, :mod:`.layout`, :mod
     cosim static SCENARIO --load X Y FZ [--load X Y FZ ...] [--json]
     cosim run [SCENARIO] [--out LOG.mcap] [--csv OUT.csv] [--force] [--quiet]
     cosim replay LOG.mcap [--scenario OTHER] [--out NEW.mcap] [--force] [--quiet]
-    cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--force]
-    cosim info LOG.mcap
-    cosim plot LOG.mcap [--sensor NAME ...] -o FIG.png [--force]
+    cosim export LOG.mcap --csv OUT.csv [--topic TOPIC] [--from T0] [--to T1] [--force]
+    cosim info LOG.mcap [--verify]
+    cosim plot LOG.mcap [--sensor NAME ...] [--from T0] [--to T1] -o FIG.png [--force]
     cosim layout LOG.mcap -o LAYOUT.json [--force]
     cosim validate [--out DIR] [--quick]
     cosim study STUDY.toml [--workers N] ...
@@ -299,17 +299,28 @@ def build_parser() -> argparse.ArgumentParser:
             per sample. {TOPIC_VEHICLES}: one row per vehicle on the deck per sample (t, id,
             model, x, y, speed, acceleration, body_displacement, body_acceleration,
             contact_force). {TOPIC_EVENTS} and {TOPIC_STATUS}: one row per message.
-            A log cut short is exported up to its last complete chunk."""
+            --from/--to: only the messages from T0 to T1 s of simulated time (both
+            included; either bound alone is fine): a finished log's chunk index is used
+            to read only the chunks in the window (10 minutes of a day-long log take about
+            as long as a 10-minute log). A log cut short is exported up to its last
+            complete chunk (it has no index: it is read whole)."""
         ),
         epilog="examples:\n  cosim export runs/run1.mcap --csv run1.csv\n"
-               f"  cosim export runs/run1.mcap --topic {TOPIC_VEHICLES} --csv vehicles.csv\n",
+               f"  cosim export runs/run1.mcap --topic {TOPIC_VEHICLES} --csv vehicles.csv\n"
+               "  cosim export runs/day.mcap --from 43200 --to 43800 --csv noon.csv\n",
         formatter_class=formatter,
     )
     export.add_argument("log", metavar="LOG.mcap", help="a cosim log")
     export.add_argument("--csv", metavar="OUT.csv", required=True, help="the CSV file to write")
     export.add_argument("--topic", default=TOPIC_SENSORS, metavar="TOPIC",
                         help=f"the topic to export (one of: {topics}; default: {TOPIC_SENSORS})")
+    # float, not finite_float: a time that is not finite is then the window check's one-line error.
+    export.add_argument("--from", dest="start", type=float, metavar="T0",
+                        help="export from t = T0 s of simulated time (default: the log's start)")
+    export.add_argument("--to", dest="end", type=float, metavar="T1",
+                        help="export up to t = T1 s, included (default: the log's end)")
     export.add_argument("--force", "-f", action="store_true", help="overwrite OUT.csv if it exists")
+    export._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
     export.set_defaults(func=cmd_export)
 
     info = commands.add_parser(
@@ -320,13 +331,19 @@ def build_parser() -> argparse.ArgumentParser:
             Summarise a log: its scenario, cosim version, simulated time, sensors, topics
             with message counts, final status and message, whether the file is truncated
             (cut short by a killed process: exit status 0, the readable part is shown) and
-            its attachments. Every chunk's checksum is verified: a damaged file or one that
-            is not a cosim MCAP log exits with status 2."""
+            its attachments. A finished log is read through its summary (counts, times,
+            chunk index) in seconds however long it is; every byte is checked against the
+            file's checksums, and the chunk holding the final status is decompressed.
+            --verify also decompresses every chunk, verifies its checksum and counts the
+            messages (the summary must agree). A damaged file or one that is not a cosim
+            MCAP log exits with status 2."""
         ),
-        epilog="example:\n  cosim info runs/run1.mcap\n",
+        epilog="examples:\n  cosim info runs/run1.mcap\n  cosim info --verify runs/run1.mcap\n",
         formatter_class=formatter,
     )
     info.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    info.add_argument("--verify", action="store_true",
+                      help="decompress every chunk and verify every checksum (seconds per 100 MB of log)")
     info.set_defaults(func=cmd_info)
 
     plot = commands.add_parser(
@@ -336,17 +353,25 @@ def build_parser() -> argparse.ArgumentParser:
             """\
             Draw the time histories of a log's sensors, one panel each, over time in s
             (displacements in mm, velocities in mm/s, accelerations in m/s^2, bending
-            moments in kN m)."""
+            moments in kN m). --from/--to: only T0 to T1 s of simulated time, read from
+            the chunks in that window. More than 20000 samples are drawn as their min/max
+            envelope."""
         ),
         epilog="examples:\n  cosim plot runs/run1.mcap -o run1.png\n"
-               "  cosim plot runs/run1.mcap --sensor node1 --sensor node3_acc -o two.png\n",
+               "  cosim plot runs/run1.mcap --sensor node1 --sensor node3_acc -o two.png\n"
+               "  cosim plot runs/day.mcap --sensor node1 --from 43200 --to 43260 -o noon.png\n",
         formatter_class=formatter,
     )
     plot.add_argument("log", metavar="LOG.mcap", help="a cosim log")
     plot.add_argument("--sensor", action="append", metavar="NAME",
                       help="a sensor to draw (repeat for more; default: all)")
     plot.add_argument("-o", "--output", required=True, metavar="FIG.png", help="the figure (.png, .pdf, .svg, ...)")
+    plot.add_argument("--from", dest="start", type=float, metavar="T0",
+                      help="draw from t = T0 s of simulated time (default: the log's start)")
+    plot.add_argument("--to", dest="end", type=float, metavar="T1",
+                      help="draw up to t = T1 s, included (default: the log's end)")
     plot.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
+    plot._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
     plot.set_defaults(func=cmd_plot)
 
     layout = commands.add_parser(

@@ -6,7 +6,7 @@ import json
 import sys
 
 from cosim.core.traffic import vehicle_of
-from cosim.log.reader import LogOverview, iter_messages, open_log
+from cosim.log.reader import LogOverview, ReadStats, file_is_complete, iter_messages, open_log
 from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.run.export import export_csv
 from cosim.run.figures import plot_log_sensors
@@ -15,22 +15,52 @@ from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 from .text import fmt_g, print_lines, size_text
 
 
+def window_text(start: float | None, end: float | None) -> str:
+    """`` from t = T0 to T1 s`` for a window of time given on the command line ("" for none)."""
+    if start is None and end is None:
+        return ""
+    low = f"t = {fmt_g(start, 9)}" if start is not None else "the start"
+    high = f"{fmt_g(end, 9)} s" if end is not None else "the end"
+    if start is None:
+        high = f"t = {high}"
+    return f" from {low} to {high}"
+
+
 def cmd_export(args: argparse.Namespace) -> int:
-    """Write a topic of a log as CSV."""
-    overview = open_log(args.log)
-    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force)
-    if overview.truncated:
+    """Write a topic of a log (or of a window of it) as CSV."""
+    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force, start=args.start,
+                               end=args.end)
+    if not file_is_complete(args.log):
         print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
               file=sys.stderr)
     units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
-    print(f"Wrote {rows} rows of {args.topic} to {args.csv} (columns {','.join(columns)}; {units})")
+    print(f"Wrote {rows} rows of {args.topic}{window_text(args.start, args.end)} to {args.csv} "
+          f"(columns {','.join(columns)}; {units})")
     return 0
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    """Summarise a log."""
-    print_lines(info_lines(open_log(args.log)))
+    """Summarise a log: from its summary, or (``--verify``) from every chunk."""
+    print_lines(info_lines(open_log(args.log, check="full" if args.verify else "file")))
     return 0
+
+
+def checked_line(o: LogOverview, extra_chunks: int = 0) -> str:
+    """What ``cosim info`` verified, and what it did not (``extra_chunks``: read after ``o``, e.g. for events)."""
+    if not o.complete:
+        return (f"Checked: the {o.chunks} complete chunk(s) decompressed and their checksums verified "
+                "(a file cut short has no summary or file checksum)")
+    older = " (this log has no file checksum: older cosim versions wrote none)" if o.data_checksum is False else ""
+    if o.check == "full":
+        file = "the file's (every byte as written), " if o.data_checksum else ""
+        agree = " (the summary agrees)" if o.summary_checked else ""
+        return (f"Checked: all {o.chunks} chunks decompressed and their checksums verified, and {file}the "
+                f"summary's and the attachments'{older}; counts from the messages{agree}")
+    file = "the file (every byte as written), " if o.data_checksum else ""
+    unread = "" if o.data_checksum else ", the others not read"
+    read = min(o.chunks_read + extra_chunks, o.chunks)
+    return (f"Checked: checksums of {file}the summary and the attachments; {read} of {o.chunks} chunks "
+            f"decompressed{unread}{older}; counts from the summary (--verify: every chunk)")
 
 
 def info_lines(o: LogOverview) -> list[str]:
@@ -58,8 +88,10 @@ def info_lines(o: LogOverview) -> list[str]:
         lines.append(f"Simulated: {fmt_g(o.end_time, 6)} s")
     sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
     lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
+    extra_chunks = 0
     if o.counts.get(TOPIC_TRAFFIC) or info.get("traffic") == "sumo":
-        lines.extend(_sumo_vehicle_lines(o))
+        vehicle_lines, extra_chunks = _sumo_vehicle_lines(o)
+        lines.extend(vehicle_lines)
     elif "vehicles" in info:
         try:
             vehicles = json.loads(info["vehicles"])
@@ -83,26 +115,45 @@ def info_lines(o: LogOverview) -> list[str]:
                      "it is read up to its last complete chunk")
     atts = ", ".join(f"{name} ({size_text(len(data))})" for name, data in o.attachments.items()) or "none"
     lines.append(f"Attachments: {atts}")
+    lines.append(checked_line(o, extra_chunks))
     return lines
 
 
 #: SUMO vehicles listed by name in ``cosim info`` (the rest are counted).
 SHOWN_VEHICLES = 20
+#: Chunks ``cosim info`` (without --verify) reads for the SUMO vehicles' events: about 20 min of the default run.
+EVENT_CHUNKS = 256
 
 
-def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
-    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run."""
+def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
+    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run,
+    and the chunks read for them.
+
+    Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
+    thousands): the vehicles of a long log are those of its start, and the line says so.
+    """
     axles: dict[str, int] = {}
+    stats = ReadStats()
+    budget = None if o.check == "full" else EVENT_CHUNKS
+    last_t, cut = 0.0, False
     if o.counts.get(TOPIC_EVENTS):
-        for _, message in iter_messages(o.path, [TOPIC_EVENTS]):
+        # A window over the whole log: a finished log's chunks are then read through its index, one at a time.
+        messages = iter_messages(o.path, [TOPIC_EVENTS], start=o.start_time, stats=stats)
+        for _, message in messages:
+            if budget is not None and stats.chunks > budget:
+                cut = True
+                break
+            last_t = float(message["t"])
             if message.get("event") == "entered":
                 contact = str(message.get("vehicle", ""))
                 axles.setdefault(contact, 0)
+        messages.close()  # type: ignore[attr-defined]
     vehicles = list(dict.fromkeys(vehicle_of(c) for c in axles))
     shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"
                                                     if len(vehicles) > SHOWN_VEHICLES else "")
     axle_text = f", {len(axles)} axles" if len(axles) != len(vehicles) else ""
-    lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{axle_text}): {shown or 'none'}"]
+    when = f", in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
+    lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{axle_text}{when}): {shown or 'none'}"]
     raw = o.attachments.get(VEHICLE_TYPES_ATTACHMENT)
     if raw is not None:
         try:
@@ -112,12 +163,12 @@ def _sumo_vehicle_lines(o: LogOverview) -> list[str]:
             lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
-    return lines
+    return lines, stats.chunks
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """Draw a log's sensor time histories."""
-    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force)
-    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)}) "
-          f"to {args.output}")
+    """Draw a log's sensor time histories (or a window of them)."""
+    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force, start=args.start, end=args.end)
+    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)})"
+          f"{window_text(args.start, args.end)} to {args.output}")
     return 0

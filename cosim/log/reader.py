@@ -1,11 +1,13 @@
 """Reading cosim logs: the one MCAP reader behind info, export, plot, replay, studies and tests.
 
 - :func:`open_log`: what a log holds without its messages (metadata,
-  attachments, message counts, the final status, sensor names), every
-  checksum verified;
+  attachments, message counts, the final status, sensor names); by default
+  every chunk is read and every checksum verified, or, for a finished log,
+  only its summary (``check="file"`` or ``"summary"``: seconds for a day-long log);
 - :func:`iter_messages`: the decoded messages of some topics, in file order,
-  chunk by chunk (constant memory); :func:`sensor_series` the sensor channels
-  as arrays;
+  chunk by chunk (constant memory), optionally within a window of simulated
+  time (only the chunks that overlap it are read); :func:`sensor_series` the
+  sensor channels as arrays;
 - :func:`read_log`: everything at once (:class:`LogContents`), for small logs
   and tests;
 - :class:`LoggedTraffic`: the logged SUMO frames as a traffic source again,
@@ -20,18 +22,28 @@ A log is untrusted input: people send logs to each other. So the reader
   size it claims (a 33 kB file claiming a 1 GB chunk made ``cosim info`` use
   2 GB): every record's length is checked against the file and against
   :mod:`cosim.core.limits` before it is read or decompressed;
-- verifies every checksum the file has: each chunk's (of its decompressed
-  records), each attachment's, and the data section's (written by cosim since
-  this version); a mismatch is damage, named by record;
+- verifies every checksum of what it reads: each chunk's (of its decompressed
+  records), each attachment's, the summary's and the data section's (the
+  file's bytes as written; older cosim logs have none); a mismatch is damage,
+  named by record;
+- checks that the messages of every chunk it reads lie in the time range its
+  header (and the summary's index) claims, so that a window can skip chunks;
 - checks every message it hands out against cosim's own schema for its topic
   (:mod:`cosim.log.checks`), and the "cosim" metadata record's values.
+
+A finished log ends with a *summary*: the channels, the message counts and an
+index of its chunks (offset and time range of each). Readers that need only
+part of the log (a window of time, the overview) follow that index instead of
+reading every chunk; what they skipped is said (:attr:`LogOverview.check`) and
+``check="full"`` (``cosim info --verify``) reads everything and checks that the
+summary agrees with the chunks.
 
 One truncation rule for all of them: a log is *complete* when it ends with the
 MCAP magic (it was finished: summary, index, footer). A complete log must be
 intact: any damage (a checksum that does not match, a malformed record) is a
-:class:`cosim.errors.LogError`. A log cut short (the process was killed) is
-read record by record up to its last complete record, and says it is
-truncated; a checksum that does not match is damage there too.
+:class:`cosim.errors.LogError`. A log cut short (the process was killed) has
+no summary: it is read record by record up to its last complete record, and
+says it is truncated; a checksum that does not match is damage there too.
 
 Logs are parsed, never evaluated or unpickled.
 """
@@ -43,21 +55,31 @@ import math
 import os
 import struct
 import zlib
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Literal
 
 import numpy as np
 import orjson
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
-from mcap.records import Channel, Chunk, DataEnd, Header, Metadata, Schema
+from mcap.records import (
+    AttachmentIndex,
+    Channel,
+    Chunk,
+    DataEnd,
+    Header,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+)
 
 from cosim.core.limits import MAX_ATTACHMENT_BYTES, MAX_CHUNK_BYTES, MAX_RECORD_BYTES
 from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
 from cosim.core.vehicles import VehicleModel, model_from_dict
-from cosim.errors import ConfigError, LogError
+from cosim.errors import ConfigError, CosimError, LogError
 
 from .checks import message_check
 from .schemas import (
@@ -68,15 +90,45 @@ from .schemas import (
     TOPIC_STATUS,
     TOPIC_TRAFFIC,
     TOPIC_VEHICLE_TYPES,
+    to_ns,
 )
 
 # --------------------------------------------------------------------------- files and records
 
 _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length of the record's body
 _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
+_CHUNK_TIMES = struct.Struct("<QQ")  # a chunk record's first fields: message start and end time
+_FOOTER = struct.Struct("<BQQQI")  # opcode, length (20), summary start, summary offset start, summary crc
+_DATA_END = struct.Struct("<BQI")  # opcode, length (4), data section crc
 _ATTACHMENT_OVERHEAD = 1 << 16  # name, media type, times and checksum around an attachment's data
+_MAX_NS = (1 << 64) - 1  # log times are unsigned 64-bit nanoseconds
+_CRC_BLOCK = 1 << 22  # bytes per read when the data section's checksum is computed
 
 
+@dataclass
+class ReadStats:
+    """What a read cost, counted as it goes (as scipy's ``OdeSolver`` counts ``nfev``): pass one to
+    :func:`open_log`, :func:`iter_messages` and the functions built on them, then look.
+
+    Attributes:
+        chunks: chunks decompressed (each one's checksum verified).
+        messages: messages decoded (JSON parsed and checked against their topic's schema).
+    """
+
+    chunks: int = 0
+    messages: int = 0
+
+
+@dataclass(frozen=True, slots=True)  # slots: a day-long log's index holds 17 000 of them
+class _ChunkEntry:
+    """Where a chunk is and what it holds: from the summary's chunk index, or from the chunk itself."""
+
+    number: int  # 1-based, in file order (the number errors name)
+    offset: int  # of the chunk record
+    length: int  # of its body
+    start: int  # log time of its first and last message, ns
+    end: int
+    channels: frozenset[int] = frozenset()  # channels with messages in it (empty: not known)
 def _open(path: Path) -> IO[bytes]:
     """The log file, opened for reading at its start; an error unless it starts like an MCAP file."""
     try:
@@ -169,14 +221,15 @@ def _attachment(path: Path, body: bytes, offset: int) -> _Attachment:
     return _Attachment(name, media_type, body[start:start + length])
 
 
-def _chunk_records(path: Path, body: bytes, offset: int, number: int) -> bytes:
-    """The records inside a chunk: decompressed within the limit, their checksum verified."""
+
+def _chunk_records(path: Path, body: bytes, offset: int, number: int) -> tuple[bytes, Chunk]:
+    """The records inside a chunk, decompressed within the limit and their checksum verified, and the
+    chunk record (its time range)."""
     try:
         chunk = Chunk.read(ReadDataStream(io.BytesIO(body)))
     except Exception:  # noqa: BLE001
         raise _corrupt(path, f"a malformed chunk record at offset {offset}") from None
-    where = (f"chunk {number} (offset {offset}, messages at t = {chunk.message_start_time / 1e9:g} to "
-             f"{chunk.message_end_time / 1e9:g} s)")
+    where = _chunk_where(number, offset, chunk.message_start_time, chunk.message_end_time)
     size = chunk.uncompressed_size
     MAX_CHUNK_BYTES.check(size, f"{path}: {where}", "its decompressed size")
     try:
@@ -204,21 +257,36 @@ def _chunk_records(path: Path, body: bytes, offset: int, number: int) -> bytes:
         raise _corrupt(path, f"{where} decompresses to {len(data)} bytes, not the {size} it claims")
     if chunk.uncompressed_crc != 0 and zlib.crc32(data) != chunk.uncompressed_crc:
         raise _corrupt(path, f"the checksum of {where} does not match: it was changed after it was written")
-    return data
+    return data, chunk
+
+
+def _chunk_where(number: int, offset: int, start: int, end: int) -> str:
+    return f"chunk {number} (offset {offset}, messages at t = {start / 1e9:g} to {end / 1e9:g} s)"
+
+
+def _check_span(path: Path, entry: _ChunkEntry, found: tuple[int, int, int]) -> None:
+    """The messages of a chunk span exactly the time range its header claims (what windows rely on)."""
+    count, first, last = found
+    if count and (first, last) != (entry.start, entry.end):
+        raise _corrupt(path, f"{_chunk_where(entry.number, entry.offset, entry.start, entry.end)} holds messages "
+                             f"at t = {first / 1e9:g} to {last / 1e9:g} s")
 
 
 def _records(path: Path, fh: IO[bytes], complete: bool, wanted_ids: set[int] | None = None,
-             others: bool = False) -> Iterator[tuple[int, Any]]:
+             tally: _Tally | None = None, window: tuple[int, int] | None = None,
+             stats: ReadStats | None = None) -> Iterator[tuple[int, Any]]:
     """(opcode, record) of every record the reader needs, in file order, chunks opened (the one record walker).
 
     Records: Header, Schema, Channel, :class:`_Message`, :class:`_Attachment`,
-    Metadata. A file cut short ends quietly after its last complete record;
-    damage (a checksum that does not match, a malformed record, or anything
-    cut short in a complete file) raises. The data section's checksum is
-    verified at its end (DataEnd); the summary after it is not needed.
+    Metadata, a :class:`_ChunkEntry` after each chunk's records, and DataEnd
+    (its checksum verified) last. A file cut short ends quietly after its last
+    complete record; damage (a checksum that does not match, a malformed
+    record, or anything cut short in a complete file) raises. The summary
+    after the data section is not read here (:func:`_read_summary`).
     Messages inside chunks on channels not in ``wanted_ids`` (a set the caller
-    may fill as channels appear; None: all) are skipped without a copy, or,
-    with ``others``, yielded without their data (for counting).
+    may fill as channels appear; None: all), or outside ``window`` (log times,
+    ns, both ends included), are skipped without a copy; ``tally``, if given,
+    counts every message record and its time.
     """
     fh.seek(0, os.SEEK_END)
     size = fh.tell()
@@ -252,29 +320,50 @@ def _records(path: Path, fh: IO[bytes], complete: bool, wanted_ids: set[int] | N
             if end.data_section_crc != 0 and end.data_section_crc != crc:
                 raise _corrupt(path, "the checksum of the data section does not match: the file was changed "
                                      "after it was written")
+            yield opcode, end
             return
         crc = zlib.crc32(body, zlib.crc32(head, crc))
         if opcode == Opcode.CHUNK:
             chunks += 1
-            yield from _inner_records(path, _chunk_records(path, body, offset, chunks), offset, wanted_ids, others)
+            data, chunk = _chunk_records(path, body, offset, chunks)
+            if stats is not None:
+                stats.chunks += 1
+            entry = _ChunkEntry(chunks, offset, length, chunk.message_start_time, chunk.message_end_time)
+            found = yield from _inner_records(path, data, offset, wanted_ids,
+                                              tally.counts if tally is not None else None, window)
+            if tally is not None:
+                tally.span(*found)
+            _check_span(path, entry, found)
+            yield opcode, entry
         elif opcode == Opcode.ATTACHMENT:
             yield opcode, _attachment(path, body, offset)
         elif opcode == Opcode.FOOTER:
             return
         else:
             record = _parse(path, opcode, body, offset)
-            if record is not None:
+            if opcode == Opcode.MESSAGE and tally is not None:
+                tally.counts[record.channel_id] = tally.counts.get(record.channel_id, 0) + 1
+                tally.span(1, record.log_time, record.log_time)
+            if record is not None and not (opcode == Opcode.MESSAGE and window is not None
+                                           and not window[0] <= record.log_time <= window[1]):
                 yield opcode, record
         offset += _RECORD_HEAD.size + length
 
 
 def _inner_records(path: Path, data: bytes, chunk_offset: int, wanted_ids: set[int] | None = None,
-                   others: bool = False) -> Iterator[tuple[int, Any]]:
-    """The records of a decompressed chunk (schemas, channels, messages)."""
+                   counts: dict[int, int] | None = None, window: tuple[int, int] | None = None
+                   ) -> Generator[tuple[int, Any], None, tuple[int, int, int]]:
+    """The records of a decompressed chunk (schemas, channels, messages; see :func:`_records`).
+
+    Returns (as a generator's value) the number of messages and their first and last log time.
+    """
     view = memoryview(data)
     position, end = 0, len(data)
     head = _RECORD_HEAD
+    unpack_message = _MESSAGE_HEAD.unpack_from
     message = Opcode.MESSAGE
+    lo, hi = window if window is not None else (0, _MAX_NS)
+    count, first, last = 0, _MAX_NS, 0
     while position < end:
         if position + head.size > end:
             raise _corrupt(path, f"the chunk at offset {chunk_offset} ends inside a record")
@@ -285,19 +374,219 @@ def _inner_records(path: Path, data: bytes, chunk_offset: int, wanted_ids: set[i
         if opcode == message:  # the hot path: no record object, no copy of the header
             if length < _MESSAGE_HEAD.size:
                 raise _corrupt(path, f"a message record in the chunk at offset {chunk_offset} is too short")
-            channel_id, _, log_time, _ = _MESSAGE_HEAD.unpack_from(data, body_start)
-            if wanted_ids is None or channel_id in wanted_ids:
+            channel_id, _, log_time, _ = unpack_message(data, body_start)
+            count += 1
+            if log_time < first:
+                first = log_time
+            if log_time > last:
+                last = log_time
+            if counts is not None:
+                counts[channel_id] = counts.get(channel_id, 0) + 1
+            if lo <= log_time <= hi and (wanted_ids is None or channel_id in wanted_ids):
                 yield opcode, _Message(channel_id, log_time, bytes(view[body_start + _MESSAGE_HEAD.size:
-                                                                          body_start + length]))
-            elif others:
-                yield opcode, _Message(channel_id, log_time, b"")
+                                                                      body_start + length]))
         else:
             record = _parse(path, opcode, bytes(view[body_start:body_start + length]), chunk_offset)
             if record is not None:
                 yield opcode, record
         position = body_start + length
+    return count, first, last
 
 
+# --------------------------------------------------------------------------- the summary of a finished log
+
+
+@dataclass
+class _Summary:
+    """The summary section of a finished log (its checksum verified), and where its data section ends."""
+
+    schemas: dict[int, Schema]
+    channels: dict[int, Channel]
+    statistics: Statistics
+    chunks: list[_ChunkEntry]  # in file order
+    attachments: list[AttachmentIndex]
+    metadata: list[MetadataIndex]
+    data_end: int  # offset of the DataEnd record: the data section is the file's bytes before it
+    data_crc: int  # the data section's checksum (0: none written)
+
+
+_SUMMARY_RECORDS: dict[int, Any] = {Opcode.SCHEMA: Schema, Opcode.CHANNEL: Channel, Opcode.STATISTICS: Statistics,
+                                    Opcode.ATTACHMENT_INDEX: AttachmentIndex, Opcode.METADATA_INDEX: MetadataIndex}
+_CHUNK_INDEX_HEAD = struct.Struct("<QQQQI")  # message start and end time, chunk offset and length, map length
+_CHUNK_INDEX_ENTRY = struct.Struct("<HQ")  # channel id, offset of its message index
+_U32, _U64 = struct.Struct("<I"), struct.Struct("<Q")
+
+
+def _chunk_index(data: bytes, position: int, length: int, shared: dict[frozenset[int], frozenset[int]]
+                 ) -> tuple[int, int, int, int, frozenset[int]]:
+    """A chunk index record's (start, end, chunk offset, chunk length, channel ids); equal sets of channel
+    ids are one object, kept in ``shared``.
+
+    Parsed with ``struct`` rather than mcap's record reader, which costs 50 us a record: a day-long log's
+    summary has 17 000 of them, read by every window and overview.
+
+    Raises:
+        ValueError: the record is malformed (its fields do not fill it exactly).
+    """
+    end = position + length
+    start_time, end_time, offset, chunk_length, map_length = _CHUNK_INDEX_HEAD.unpack_from(data, position)
+    position += _CHUNK_INDEX_HEAD.size
+    if map_length % _CHUNK_INDEX_ENTRY.size or position + map_length > end:
+        raise ValueError("a message index map that does not fit")
+    ids = frozenset(cid for cid, _ in _CHUNK_INDEX_ENTRY.iter_unpack(data[position:position + map_length]))
+    ids = shared.setdefault(ids, ids)
+    position += map_length + _U64.size  # the message indexes' length
+    (compression_length,) = _U32.unpack_from(data, position)
+    position += _U32.size + compression_length + 2 * _U64.size  # compression, compressed and uncompressed size
+    if position != end:
+        raise ValueError("fields that do not fill the record")
+    return start_time, end_time, offset, chunk_length, ids
+
+
+def _read_summary(path: Path, fh: IO[bytes]) -> _Summary | None:
+    """The summary of a complete log, or None when it has none the fast readers can use (they then walk the
+    file): no summary, no statistics or chunk index, or not the usual layout.
+
+    Raises:
+        LogError: the footer or the summary is damaged (its checksum, a malformed record, an index that
+            points outside the data section), or larger than :data:`cosim.core.limits.MAX_RECORD_BYTES`.
+    """
+    fh.seek(0, os.SEEK_END)
+    size = fh.tell()
+    footer_at = size - len(MAGIC) - _FOOTER.size
+    if footer_at < len(MAGIC):
+        return None
+    fh.seek(footer_at)
+    footer = fh.read(_FOOTER.size)
+    opcode, length, start, offsets_start, crc = _FOOTER.unpack(footer)
+    if opcode != Opcode.FOOTER or length != _FOOTER.size - _RECORD_HEAD.size:
+        raise _corrupt(path, f"the footer (offset {footer_at}) is malformed")
+    if start == 0:
+        return None
+    if not (len(MAGIC) + _DATA_END.size <= start <= footer_at) or not (offsets_start == 0
+                                                                       or start <= offsets_start <= footer_at):
+        raise _corrupt(path, f"the footer (offset {footer_at}) points outside the file")
+    MAX_RECORD_BYTES.check(footer_at - start, f"{path}: the summary section (offset {start})")
+    fh.seek(start)
+    data = fh.read(footer_at - start)
+    if crc != 0 and zlib.crc32(footer[:-4], zlib.crc32(data)) != crc:
+        raise _corrupt(path, "the checksum of the summary does not match: it was changed after it was written")
+    fh.seek(start - _DATA_END.size)
+    end_opcode, end_length, data_crc = _DATA_END.unpack(fh.read(_DATA_END.size))
+    if end_opcode != Opcode.DATA_END or end_length != 4:
+        return None  # a data section that does not end where the summary starts: walk it
+    data_end = start - _DATA_END.size
+    found: dict[int, list[Any]] = {}
+    channel_sets: dict[frozenset[int], frozenset[int]] = {}
+    position = 0
+    while position < len(data):
+        if position + _RECORD_HEAD.size > len(data):
+            raise _corrupt(path, f"the summary (offset {start}) ends inside a record")
+        opcode, length = _RECORD_HEAD.unpack_from(data, position)
+        body = position + _RECORD_HEAD.size
+        if length > len(data) - body:
+            raise _corrupt(path, f"a record of the summary at offset {start + position} runs past its end")
+        reader = _SUMMARY_RECORDS.get(opcode)
+        if opcode == Opcode.CHUNK_INDEX:
+            try:
+                found.setdefault(opcode, []).append(_chunk_index(data, body, length, channel_sets))
+            except (ValueError, struct.error):
+                raise _corrupt(path, f"a malformed ChunkIndex record in the summary (offset {start + position})"
+                               ) from None
+        elif reader is not None:
+            stream = ReadDataStream(io.BytesIO(data[body:body + length]))
+            try:
+                record = reader.read(stream)
+                if stream.count != length:
+                    raise ValueError("the record's fields do not fill it")
+            except Exception:  # noqa: BLE001 - any parse failure of a whole record is damage
+                raise _corrupt(path, f"a malformed {reader.__name__} record in the summary "
+                                     f"(offset {start + position})") from None
+            found.setdefault(opcode, []).append(record)
+        position = body + length
+    statistics = found.get(Opcode.STATISTICS, [])
+    indexes = sorted(found.get(Opcode.CHUNK_INDEX, []), key=lambda c: c[2])
+    channels = {c.id: c for c in found.get(Opcode.CHANNEL, [])}
+    if len(statistics) != 1 or statistics[0].chunk_count != len(indexes) \
+            or any(n and cid not in channels for cid, n in statistics[0].channel_message_counts.items()):
+        return None  # written without statistics, a chunk index or the channels
+    chunks = []
+    for number, (start_time, end_time, offset, chunk_length, ids) in enumerate(indexes, start=1):
+        if not (len(MAGIC) <= offset and offset + chunk_length <= data_end
+                and chunk_length >= _RECORD_HEAD.size + _CHUNK_TIMES.size and start_time <= end_time):
+            raise _corrupt(path, f"the summary's index of chunk {number} points outside the data section "
+                                 f"(offset {offset}, {chunk_length} bytes)")
+        chunks.append(_ChunkEntry(number, offset, chunk_length - _RECORD_HEAD.size, start_time, end_time, ids))
+    for index in [*found.get(Opcode.ATTACHMENT_INDEX, []), *found.get(Opcode.METADATA_INDEX, [])]:
+        if not (len(MAGIC) <= index.offset and index.offset + index.length <= data_end):
+            raise _corrupt(path, f"the summary's index of {index.name!r} points outside the data section")
+    return _Summary(schemas={s.id: s for s in found.get(Opcode.SCHEMA, [])}, channels=channels,
+                    statistics=statistics[0],
+                    chunks=chunks, attachments=found.get(Opcode.ATTACHMENT_INDEX, []),
+                    metadata=found.get(Opcode.METADATA_INDEX, []), data_end=data_end, data_crc=data_crc)
+
+
+def _record_at(path: Path, fh: IO[bytes], offset: int, opcode: int, length: int, what: str) -> bytes:
+    """The body of the record at ``offset`` that an index points to: it must be an ``opcode`` record of
+    ``length`` bytes with its head (the caller checked ``length`` against its limit)."""
+    fh.seek(0, os.SEEK_END)
+    size = fh.tell()
+    fh.seek(offset)
+    head = fh.read(_RECORD_HEAD.size)
+    found, body_length = _RECORD_HEAD.unpack(head) if len(head) == _RECORD_HEAD.size else (None, 0)
+    if found != opcode or body_length + _RECORD_HEAD.size != length or body_length > size - offset - _RECORD_HEAD.size:
+        raise _corrupt(path, f"the summary's index points to {what} at offset {offset}, where there is none")
+    return fh.read(body_length)
+
+
+def _read_chunk(path: Path, fh: IO[bytes], entry: _ChunkEntry, stats: ReadStats | None) -> bytes:
+    """A chunk the summary's index points to: read, decompressed and checked (checksum, time range)."""
+    MAX_CHUNK_BYTES.check(entry.length, f"{path}: the chunk at offset {entry.offset}", "its compressed size")
+    body = _record_at(path, fh, entry.offset, Opcode.CHUNK, entry.length + _RECORD_HEAD.size,
+                      f"chunk {entry.number}")
+    data, chunk = _chunk_records(path, body, entry.offset, entry.number)
+    if (chunk.message_start_time, chunk.message_end_time) != (entry.start, entry.end):
+        where = _chunk_where(entry.number, entry.offset, chunk.message_start_time, chunk.message_end_time)
+        raise _corrupt(path, f"{where} is not what the summary's index says (t = {entry.start / 1e9:g} to "
+                             f"{entry.end / 1e9:g} s)")
+    if stats is not None:
+        stats.chunks += 1
+    return data
+
+
+def _header(path: Path, fh: IO[bytes]) -> Header:
+    """The header record, which must open a cosim log (its profile checked)."""
+    fh.seek(len(MAGIC))
+    head = fh.read(_RECORD_HEAD.size)
+    opcode, length = _RECORD_HEAD.unpack(head) if len(head) == _RECORD_HEAD.size else (None, 0)
+    if opcode != Opcode.HEADER:
+        _check_profile(path, None)
+    MAX_RECORD_BYTES.check(length, f"{path}: the record at offset {len(MAGIC)} (opcode {Opcode.HEADER:#04x})")
+    header = _parse(path, Opcode.HEADER, fh.read(length), len(MAGIC))
+    _check_profile(path, header.profile)
+    return header
+
+
+def _indexed_records(path: Path, fh: IO[bytes], summary: _Summary, wanted_ids: set[int] | None,
+                     window: tuple[int, int], stats: ReadStats | None) -> Iterator[tuple[int, Any]]:
+    """The records a window needs, found through the summary: the header, the schemas and channels, and the
+    records of the chunks whose time range overlaps ``window`` and that hold a wanted channel (see
+    :func:`_records`; no attachments, metadata or DataEnd)."""
+    yield Opcode.HEADER, _header(path, fh)
+    for schema in summary.schemas.values():
+        yield Opcode.SCHEMA, schema
+    for channel in summary.channels.values():
+        yield Opcode.CHANNEL, channel  # the caller fills ``wanted_ids`` from these
+    lo, hi = window
+    for entry in summary.chunks:
+        if entry.end < lo or entry.start > hi:
+            continue
+        if wanted_ids is not None and entry.channels and entry.channels.isdisjoint(wanted_ids):
+            continue
+        data = _read_chunk(path, fh, entry, stats)
+        found = yield from _inner_records(path, data, entry.offset, wanted_ids, None, window)
+        _check_span(path, entry, found)
+        yield Opcode.CHUNK, entry
 def _decode(path: Path, channel: Channel, data: bytes) -> dict:
     """One message as a JSON object checked against cosim's schema for its topic (the one decoder)."""
     if channel.message_encoding != "json":
@@ -366,7 +655,11 @@ def _check_info(path: Path, info: dict[str, str]) -> None:
             raise LogError(f"{path}: malformed cosim metadata: inputs: expected a JSON object of file names")
 
 
+
 # --------------------------------------------------------------------------- overview
+
+#: How much of a log :func:`open_log` reads: see there.
+Check = Literal["full", "file", "summary"]
 
 
 @dataclass
@@ -380,11 +673,21 @@ class LogOverview:
         metadata: name -> {key: value}.
         attachments: name -> bytes.
         counts: topic -> messages.
+        start_time: log time of the first message, s.
         end_time: log time of the last message, s (simulated time reached).
         final_status: the last /cosim/status message, or None.
         sensor_names: the sensor channels (from the metadata or the sensor schema).
         quantities: the quantity of each sensor channel ("" when the log does not say).
         size: bytes.
+        check: how it was read: "full" (every chunk decompressed and checked; counts from the messages),
+            or "file"/"summary" (a finished log's summary; counts and times from it; see :func:`open_log`).
+        chunks: chunks in the log (up to the cut, for a log cut short).
+        chunks_read: chunks decompressed, each one's checksum verified.
+        data_checksum: the data section's checksum (every byte of the file before the summary): True
+            verified, False the log has none (older cosim logs), None not checked (a log cut short has
+            none; ``check="summary"`` does not read it).
+        summary_checked: the summary's checksum verified (and, with ``check="full"``, the summary found to
+            agree with the chunks); False for a log without one (cut short).
     """
 
     path: Path
@@ -393,11 +696,17 @@ class LogOverview:
     metadata: dict[str, dict[str, str]] = field(default_factory=dict)
     attachments: dict[str, bytes] = field(default_factory=dict)
     counts: dict[str, int] = field(default_factory=dict)
+    start_time: float = 0.0
     end_time: float = 0.0
     final_status: dict | None = None
     sensor_names: list[str] = field(default_factory=list)
     quantities: list[str] = field(default_factory=list)
     size: int = 0
+    check: str = "full"
+    chunks: int = 0
+    chunks_read: int = 0
+    data_checksum: bool | None = None
+    summary_checked: bool = False
 
     @property
     def truncated(self) -> bool:
@@ -415,25 +724,50 @@ class LogOverview:
         return str(status.get("state", "unknown")) + ("" if self.complete else " (truncated)")
 
 
-def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, others: bool = False
+class _Tally:
+    """Messages counted per channel, and the first and last log time among them (ns)."""
+
+    def __init__(self) -> None:
+        self.counts: dict[int, int] = {}
+        self.first = _MAX_NS
+        self.last = -1
+
+    def span(self, count: int, first: int, last: int) -> None:
+        if count:
+            self.first = min(self.first, first)
+            self.last = max(self.last, last)
+
+
+def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, tally: _Tally | None = None,
+          window: tuple[int, int] | None = None, summary: _Summary | None = None, stats: ReadStats | None = None
           ) -> Iterator[tuple[str, Any]]:
     """The events of a log in file order (the one walker behind every reader):
 
     ``("header", Header)`` first (the profile checked), ``("schema", Schema)``,
     ``("channel", Channel)``, ``("attachment", _Attachment)``, ``("metadata",
     Metadata)``, ``("message", (channel, _Message))`` for messages on ``wanted``
-    topics (all if None; undecoded), with ``others`` the other messages too
-    (their data empty), and ``("end", complete)`` last.
+    topics (all if None; undecoded) within ``window`` (log times, ns, both
+    ends included; None: all), ``("chunk", _ChunkEntry)`` after each chunk's
+    messages, ``("data_end", DataEnd)``, and ``("end", complete)`` last.
+
+    With a ``window`` and the log's ``summary``, only the chunks that overlap
+    the window are read (no attachments, metadata or data-section checksum:
+    :func:`_indexed_records`); otherwise every record is (:func:`_records`).
     """
     channels: dict[int, Channel] = {}
     wanted_ids: set[int] = set()
+    ids = None if wanted is None else wanted_ids
+    if summary is not None and window is not None:
+        records = _indexed_records(path, fh, summary, ids, window, stats)
+    else:
+        records = _records(path, fh, complete, ids, tally, window, stats)
     first = True
-    for opcode, record in _records(path, fh, complete, None if wanted is None else wanted_ids, others):
+    for opcode, record in records:
         if first:
             _check_profile(path, record.profile if opcode == Opcode.HEADER else None)
             first = False
         if opcode == Opcode.MESSAGE:
-            if record.channel_id in wanted_ids or (others and record.channel_id in channels):
+            if record.channel_id in wanted_ids:
                 yield "message", (channels[record.channel_id], record)
         elif opcode == Opcode.CHANNEL:
             channels[record.id] = record
@@ -442,6 +776,8 @@ def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, ot
             else:
                 wanted_ids.discard(record.id)
             yield "channel", record
+        elif opcode == Opcode.CHUNK:
+            yield "chunk", record
         elif opcode == Opcode.HEADER:
             yield "header", record
         elif opcode == Opcode.SCHEMA:
@@ -450,64 +786,51 @@ def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, ot
             yield "attachment", record
         elif opcode == Opcode.METADATA:
             yield "metadata", record
+        elif opcode == Opcode.DATA_END:
+            yield "data_end", record
     if first:
         _check_profile(path, None)
     yield "end", complete
 
 
-def open_log(path: str | os.PathLike[str]) -> LogOverview:
+def open_log(path: str | os.PathLike[str], check: Check = "full", stats: ReadStats | None = None) -> LogOverview:
     """Read a log's metadata, attachments, message counts and final status (not the messages' contents).
 
-    One pass over the file: every chunk is decompressed (within
-    :data:`cosim.core.limits.MAX_CHUNK_BYTES`) and its checksum verified, as are
-    the attachments' and the data section's; only the status messages are
-    decoded. A log cut short is read up to its last complete record. Memory:
-    one chunk at a time, plus the attachments (at most
-    :data:`cosim.core.limits.MAX_ATTACHMENT_BYTES`).
+    ``check`` says how much of a finished log is read (a log cut short has no
+    summary and is always read whole, as with "full"):
+
+    - ``"full"`` (``cosim info --verify``): one pass over the file; every chunk
+      is decompressed (within :data:`cosim.core.limits.MAX_CHUNK_BYTES`) and
+      its checksum verified, as are the attachments', the data section's and
+      the summary's; the counts come from the messages, and the summary must
+      agree with them. Seconds per 100 MB of log.
+    - ``"file"`` (``cosim info``): the summary (counts, times, chunk index),
+      the metadata and attachments it points to, and the chunk(s) holding the
+      final status; every byte of the file is checked against the data
+      section's checksum, without decompressing the other chunks.
+    - ``"summary"`` (export and plot, before they read what they need): the
+      same without the data section's checksum: its cost does not grow with
+      the log.
+
+    Only the status messages are decoded. Memory: one chunk at a time, plus
+    the attachments (at most :data:`cosim.core.limits.MAX_ATTACHMENT_BYTES`).
 
     Raises:
         LogError: missing, not MCAP, not a cosim log, damaged (which record), over a limit, or its
             metadata or status messages are not what cosim writes.
     """
+    if check not in ("full", "file", "summary"):
+        raise ValueError(f"check: expected 'full', 'file' or 'summary', got {check!r}")
     path = Path(path)
     with _open(path) as fh:
         complete = _ends_with_magic(fh)
         fh.seek(0, os.SEEK_END)
         out = LogOverview(path=path, complete=complete, size=fh.tell())
-        fh.seek(0)
-        schemas: dict[int, bytes] = {}
-        sensor_schema: bytes | None = None
-        counts: dict[int, int] = {}
-        end_ns = 0
-        last_status: tuple[int, Channel, bytes] | None = None
-        status_ids: set[int] = set()
-        topics: dict[int, str] = {}
-        for kind, item in _walk(path, fh, complete, {TOPIC_STATUS}, others=True):  # data of the statuses only
-            if kind == "message":
-                channel, message = item
-                counts[message.channel_id] = counts.get(message.channel_id, 0) + 1
-                end_ns = max(end_ns, message.log_time)
-                if message.channel_id in status_ids and (last_status is None or message.log_time >= last_status[0]):
-                    last_status = (message.log_time, channel, message.data)
-            elif kind == "channel":
-                topics[item.id] = item.topic
-                if item.topic == TOPIC_STATUS:
-                    status_ids.add(item.id)
-                if item.topic == TOPIC_SENSORS:
-                    sensor_schema = schemas.get(item.schema_id)
-            elif kind == "schema":
-                schemas[item.id] = item.data
-            elif kind == "attachment":
-                out.attachments[item.name] = item.data
-            elif kind == "metadata":
-                out.metadata[item.name] = dict(item.metadata)
-            elif kind == "header":
-                out.library = item.library
-    for cid, count in counts.items():
-        out.counts[topics[cid]] = out.counts.get(topics[cid], 0) + count
-    out.end_time = end_ns / 1e9
-    if last_status is not None:
-        out.final_status = _decode(path, last_status[1], last_status[2])
+        summary = _read_summary(path, fh) if complete else None
+        if summary is not None and check != "full":
+            sensor_schema = _overview_from_summary(path, fh, summary, out, check, stats)
+        else:
+            sensor_schema = _overview_from_walk(path, fh, summary, out, stats)
     info = out.info
     _check_info(path, info)
     out.sensor_names = _json_list(info["sensors"], "sensors", path) if "sensors" in info else []
@@ -523,24 +846,241 @@ def open_log(path: str | os.PathLike[str]) -> LogOverview:
     return out
 
 
+def _overview_from_walk(path: Path, fh: IO[bytes], summary: _Summary | None, out: LogOverview,
+                        stats: ReadStats | None) -> bytes | None:
+    """Fill ``out`` from every record of the file (and check the summary, if any, against the chunks);
+    returns the sensor topic's schema."""
+    schemas: dict[int, bytes] = {}
+    sensor_schema: bytes | None = None
+    topics: dict[int, str] = {}
+    tally = _Tally()
+    chunks: list[_ChunkEntry] = []
+    last_status: tuple[int, Channel, bytes] | None = None
+    for kind, item in _walk(path, fh, out.complete, {TOPIC_STATUS}, tally=tally, stats=stats):
+        if kind == "message":  # a status message: the only ones decoded
+            channel, message = item
+            if last_status is None or message.log_time >= last_status[0]:
+                last_status = (message.log_time, channel, message.data)
+        elif kind == "chunk":
+            chunks.append(item)
+        elif kind == "channel":
+            topics[item.id] = item.topic
+            if item.topic == TOPIC_SENSORS:
+                sensor_schema = schemas.get(item.schema_id)
+        elif kind == "schema":
+            schemas[item.id] = item.data
+        elif kind == "attachment":
+            out.attachments[item.name] = item.data
+        elif kind == "metadata":
+            out.metadata[item.name] = dict(item.metadata)
+        elif kind == "header":
+            out.library = item.library
+        elif kind == "data_end":
+            out.data_checksum = item.data_section_crc != 0
+    for cid, count in tally.counts.items():
+        if cid in topics:
+            out.counts[topics[cid]] = out.counts.get(topics[cid], 0) + count
+    if tally.last >= 0:
+        out.start_time, out.end_time = tally.first / 1e9, tally.last / 1e9
+    if last_status is not None:
+        out.final_status = _decode(path, last_status[1], last_status[2])
+    out.check, out.chunks, out.chunks_read = "full", len(chunks), len(chunks)
+    if summary is not None:
+        _compare_summary(path, summary, chunks, tally)
+        out.summary_checked = True
+    return sensor_schema
+
+
+def _compare_summary(path: Path, summary: _Summary, chunks: list[_ChunkEntry], tally: _Tally) -> None:
+    """The summary (what windows and the overview trust) must say what the chunks hold."""
+    indexed = [(e.offset, e.length, e.start, e.end) for e in summary.chunks]
+    walked = [(e.offset, e.length, e.start, e.end) for e in chunks]
+    if indexed != walked:
+        at = next((i for i, (a, b) in enumerate(zip(indexed, walked)) if a != b), min(len(indexed), len(walked)))
+        raise _corrupt(path, f"the summary's chunk index does not match the chunks (it lists {len(indexed)}, the "
+                             f"file holds {len(walked)}; they differ from chunk {at + 1} on)")
+    stats = summary.statistics
+    claimed = {cid: n for cid, n in stats.channel_message_counts.items() if n}
+    if claimed != {cid: n for cid, n in tally.counts.items() if n}:
+        topic = next((summary.channels[c].topic if c in summary.channels else f"channel {c}"
+                      for c in sorted(set(claimed) | set(tally.counts))
+                      if claimed.get(c, 0) != tally.counts.get(c, 0)), "?")
+        raise _corrupt(path, f"the summary's message counts do not match the chunks (on {topic})")
+    if stats.message_count and (stats.message_start_time, stats.message_end_time) != (tally.first, tally.last):
+        raise _corrupt(path, "the summary's time range does not match the messages")
+
+
+def _overview_from_summary(path: Path, fh: IO[bytes], summary: _Summary, out: LogOverview, check: str,
+                           stats: ReadStats | None) -> bytes | None:
+    """Fill ``out`` from a finished log's summary and what it points to; returns the sensor topic's schema."""
+    out.library = _header(path, fh).library
+    for index in summary.metadata:
+        MAX_RECORD_BYTES.check(index.length, f"{path}: the record at offset {index.offset} "
+                                             f"(opcode {Opcode.METADATA:#04x})")
+        body = _record_at(path, fh, index.offset, Opcode.METADATA, index.length, f"metadata {index.name!r}")
+        record = _parse(path, Opcode.METADATA, body, index.offset)
+        out.metadata[record.name] = dict(record.metadata)
+    attachment_bytes = 0
+    for where in summary.attachments:
+        attachment_bytes += where.length - _RECORD_HEAD.size
+        MAX_ATTACHMENT_BYTES.check(attachment_bytes - _ATTACHMENT_OVERHEAD, f"{path}: the attachments",
+                                   f"up to the record at offset {where.offset}")
+        body = _record_at(path, fh, where.offset, Opcode.ATTACHMENT, where.length, f"attachment {where.name!r}")
+        attachment = _attachment(path, body, where.offset)
+        out.attachments[attachment.name] = attachment.data
+    statistics = summary.statistics
+    for cid, count in statistics.channel_message_counts.items():
+        if count:  # every counted channel is defined (_read_summary)
+            topic = summary.channels[cid].topic
+            out.counts[topic] = out.counts.get(topic, 0) + count
+    if statistics.message_count:
+        out.start_time, out.end_time = statistics.message_start_time / 1e9, statistics.message_end_time / 1e9
+    before = stats.chunks if stats is not None else 0
+    counter = stats if stats is not None else ReadStats()
+    out.final_status = _last_status(path, fh, summary, counter)
+    out.check, out.chunks, out.chunks_read = check, len(summary.chunks), counter.chunks - before
+    out.summary_checked = True
+    if check == "file":
+        if summary.data_crc != 0:
+            _check_data_section(path, fh, summary.data_end, summary.data_crc)
+        out.data_checksum = summary.data_crc != 0
+    channel = next((c for c in summary.channels.values() if c.topic == TOPIC_SENSORS), None)
+    schema = summary.schemas.get(channel.schema_id) if channel is not None else None
+    return schema.data if schema is not None else None
+
+
+def _last_status(path: Path, fh: IO[bytes], summary: _Summary, stats: ReadStats) -> dict | None:
+    """The last status message (the latest log time, the last in file order among equals), read from the
+    last chunk(s) that hold status messages, as the summary's chunk index says."""
+    ids = {cid for cid, channel in summary.channels.items() if channel.topic == TOPIC_STATUS}
+    if not ids:
+        return None
+    known = any(entry.channels for entry in summary.chunks)  # an index that says which channels a chunk holds
+    candidates = sorted((e for e in summary.chunks if not known or not e.channels.isdisjoint(ids)),
+                        key=lambda e: (e.end, e.offset), reverse=True)
+    best: tuple[int, int, int] | None = None  # log time, chunk offset, position in the chunk
+    found: _Message | None = None
+    for entry in candidates:
+        if best is not None and (entry.end, entry.offset) < best[:2]:
+            break  # no status message in this chunk or the ones after it can come later
+        data = _read_chunk(path, fh, entry, stats)
+        records = _inner_records(path, data, entry.offset, ids)
+        position = 0
+        while True:
+            try:
+                _, message = next(records)
+            except StopIteration as done:
+                _check_span(path, entry, done.value)
+                break
+            if isinstance(message, _Message):
+                position += 1
+                key = (message.log_time, entry.offset, position)
+                if best is None or key >= best:
+                    best, found = key, message
+    if found is None:
+        return None
+    return _decode(path, summary.channels[found.channel_id], found.data)
+
+
+def _check_data_section(path: Path, fh: IO[bytes], data_end: int, expected: int) -> None:
+    """Every byte before DataEnd against the data section's checksum, read in blocks (constant memory)."""
+    fh.seek(0)
+    crc = 0
+    buffer = memoryview(bytearray(_CRC_BLOCK))
+    remaining = data_end
+    while remaining:
+        n = fh.readinto(buffer[:min(_CRC_BLOCK, remaining)])  # type: ignore[attr-defined]
+        if not n:
+            raise _corrupt(path, "the file ends before its data section does")
+        crc = zlib.crc32(buffer[:n], crc)
+        remaining -= n
+    if crc != expected:
+        raise _corrupt(path, "the checksum of the data section does not match: the file was changed "
+                             "after it was written")
+
+
+# --------------------------------------------------------------------------- windows of time
+
+
+def _window_ns(start: float | None, end: float | None) -> tuple[int, int] | None:
+    """A window of simulated time (s; None: open on that side) as log times (ns, both ends included)."""
+    if start is None and end is None:
+        return None
+    for name, value in (("start", start), ("end", end)):
+        if value is not None and not math.isfinite(value):
+            raise CosimError(f"`{name}` of the time window: expected a finite time in s, got {value!r}")
+    lo = 0 if start is None else max(_log_time(start), 0)
+    hi = _MAX_NS if end is None else _log_time(end)
+    return lo, hi
+
+
+def _log_time(t: float) -> int:
+    """A finite time in s as a log time (ns, as :func:`cosim.log.schemas.to_ns`), clamped to what log times
+    can be (and one below: nothing lies before a negative end)."""
+    ns = t * 1e9
+    if ns >= _MAX_NS:
+        return _MAX_NS
+    return to_ns(t) if ns > -1.0 else -1
+
+
+def check_window(start: float | None, end: float | None, overview: LogOverview | None = None) -> None:
+    """Check a window of simulated time ``[start, end]`` (s; None: the log's start or end): finite, not
+    empty, and, given the log's ``overview``, overlapping the time the log covers.
+
+    Raises:
+        CosimError: one line naming ``--from``/``--to`` (and what the log covers).
+    """
+    for option, value in (("--from", start), ("--to", end)):
+        if value is not None and not math.isfinite(value):
+            raise CosimError(f"{option} {value!r}: expected a finite time in s")
+    if start is not None and end is not None and not end > start:
+        raise CosimError(f"--from {start:g} --to {end:g}: an empty window; --to must be later than --from")
+    if overview is None:
+        return
+    path = overview.path
+    if not overview.counts:
+        raise CosimError(f"{path}: the log holds no messages, so no window of it can be read")
+    covers = f"the log covers t = {overview.start_time:g} to {overview.end_time:g} s"
+    if start is not None and _log_time(start) > _log_time(overview.end_time):
+        raise CosimError(f"{path}: --from {start:g} s: after the end of the log ({covers})")
+    if end is not None and _log_time(end) < _log_time(overview.start_time):
+        raise CosimError(f"{path}: --to {end:g} s: before the start of the log ({covers})")
+
+
 # --------------------------------------------------------------------------- messages
 
 
-def iter_messages(path: str | os.PathLike[str], topics: Iterable[str]) -> Iterator[tuple[str, dict]]:
+def iter_messages(path: str | os.PathLike[str], topics: Iterable[str], start: float | None = None,
+                  end: float | None = None, stats: ReadStats | None = None) -> Iterator[tuple[str, dict]]:
     """The decoded messages on ``topics`` as (topic, message), in file order, chunk by chunk (constant memory).
+
+    With ``start`` and/or ``end`` (s of simulated time, both included; None:
+    open on that side), only the messages whose log time lies in the window:
+    a finished log is read through its summary's chunk index, so only the
+    chunks that overlap the window are read and decompressed (their
+    checksums verified, and the summary's; the rest of the file is not read);
+    a log cut short has no index and is walked whole, skipping the messages
+    outside the window before they are decoded. Without a window every record
+    is read and every checksum verified.
 
     Every message is checked against cosim's schema for its topic. A log cut
     short yields what it holds up to its last complete record.
 
     Raises:
         LogError: missing, not MCAP, not a cosim log, damaged, or a message that does not match its schema.
+        CosimError: a bound of the window that is not finite.
     """
     path = Path(path)
     wanted = set(topics)
+    window = _window_ns(start, end)
     with _open(path) as fh:
-        for kind, item in _walk(path, fh, _ends_with_magic(fh), wanted):
+        complete = _ends_with_magic(fh)
+        summary = _read_summary(path, fh) if complete and window is not None else None
+        for kind, item in _walk(path, fh, complete, wanted, window=window, summary=summary, stats=stats):
             if kind == "message":
                 channel, message = item
+                if stats is not None:
+                    stats.messages += 1
                 yield channel.topic, _decode(path, channel, message.data)
 
 
@@ -566,17 +1106,19 @@ def _sensor_values(path: Path, message: dict, names: Sequence[str]) -> list[floa
                        f"{exc.args[0]!r}") from None
 
 
-def sensor_series(path: str | os.PathLike[str], names: Sequence[str] | None = None
+def sensor_series(path: str | os.PathLike[str], names: Sequence[str] | None = None, start: float | None = None,
+                  end: float | None = None, stats: ReadStats | None = None
                   ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """The sensor channels of a log as arrays (t, {name: values}), sorted by time (all channels by default).
+    """The sensor channels of a log as arrays (t, {name: values}), sorted by time (all channels by default),
+    within the window ``[start, end]`` if given (see :func:`iter_messages`).
 
-    Memory grows with the log (8 bytes per sample and channel); :func:`iter_messages` streams.
+    Memory grows with the samples read (8 bytes per sample and channel); :func:`iter_messages` streams.
     """
     path = Path(path)
-    names = list(names) if names is not None else open_log(path).sensor_names
+    names = list(names) if names is not None else open_log(path, check="summary", stats=stats).sensor_names
     t: list[float] = []
     rows: list[list[float]] = []
-    for _, msg in iter_messages(path, [TOPIC_SENSORS]):
+    for _, msg in iter_messages(path, [TOPIC_SENSORS], start, end, stats):
         t.append(float(msg["t"]))
         rows.append(_sensor_values(path, msg, names))
     t_arr = np.asarray(t, dtype=float)

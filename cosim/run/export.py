@@ -8,7 +8,7 @@ from typing import Any
 
 from cosim.core.fields import VEHICLE_FIELDS
 from cosim.errors import CosimError
-from cosim.log.reader import iter_messages, open_log
+from cosim.log.reader import ReadStats, check_window, iter_messages, open_log
 from cosim.log.schemas import (
     EVENTS_SCHEMA,
     STATUS_SCHEMA,
@@ -37,22 +37,31 @@ def _cell(value: Any) -> str:
 
 
 def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: str = TOPIC_SENSORS,
-               force: bool = False) -> tuple[int, list[str]]:
+               force: bool = False, start: float | None = None, end: float | None = None,
+               stats: ReadStats | None = None) -> tuple[int, list[str]]:
     """Write one topic of a log as CSV (SI units, a header row); returns (rows, columns).
 
     ``/cosim/sensors``: ``t,<sensor names>``; ``/cosim/vehicles``: one row per
     vehicle per sample (:data:`VEHICLE_COLUMNS`); events and status: one row per
-    message. A log cut short is exported up to its last complete record. Written
+    message. With ``start`` and/or ``end`` (s of simulated time, both included),
+    only the messages in that window: exactly the rows of the whole export whose
+    message lies in it, read from the chunks that overlap it
+    (:func:`cosim.log.reader.iter_messages`). A log cut short is exported up to
+    its last complete record. Memory does not grow with the log. Written
     through a temporary file, so a failure leaves no half file.
 
     Raises:
-        LogError: the log cannot be read. CosimError: not an exportable topic, or the CSV cannot be written.
+        LogError: the log cannot be read. CosimError: not an exportable topic, a window that is empty or
+            outside the log, or the CSV cannot be written.
     """
     log, out = Path(log), Path(out)
-    overview = open_log(log)
+    check_window(start, end)  # before the log is read
+    overview = open_log(log, check="summary", stats=stats)
     if topic not in EXPORT_TOPICS:
         present = ", ".join(t for t in EXPORT_TOPICS if overview.counts.get(t))
         raise CosimError(f"--topic {topic}: not an exportable topic (this log has: {present})")
+    if start is not None or end is not None:
+        check_window(start, end, overview)
     if topic == TOPIC_SENSORS:
         columns = ["t", *overview.sensor_names]
     elif topic == TOPIC_VEHICLES:
@@ -67,7 +76,7 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
     with atomic_write(out, "CSV") as partial, open(partial, "w", newline="", encoding="utf-8") as fh:
         writer = csv.writer(fh)
         writer.writerow(columns)
-        for _, msg in iter_messages(log, [topic]):
+        for _, msg in iter_messages(log, [topic], start, end, stats):
             if topic == TOPIC_VEHICLES:
                 for vehicle in msg["vehicles"]:
                     writer.writerow([_cell(msg["t"]), *(_cell(vehicle.get(c)) for c in columns[1:])])

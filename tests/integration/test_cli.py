@@ -36,9 +36,9 @@ from _cli import cosim_cli, cosim_process  # noqa: E402
         (("modes",), ["SCENARIO", "--count", "--json", "--plot", "examples:"]),
         (("run",), ["SCENARIO", "--out", "LOG.mcap", "--csv", "--force", "--quiet", "paper-double-tee", "examples:"]),
         (("replay",), ["LOG.mcap", "--scenario", "--out", "bit for bit", "examples:"]),
-        (("export",), ["LOG.mcap", "--csv", "--topic", "/cosim/vehicles", "examples:"]),
-        (("info",), ["LOG.mcap", "truncated", "example:"]),
-        (("plot",), ["LOG.mcap", "--sensor", "-o", "examples:"]),
+        (("export",), ["LOG.mcap", "--csv", "--topic", "/cosim/vehicles", "--from", "--to", "examples:"]),
+        (("info",), ["LOG.mcap", "truncated", "--verify", "examples:"]),
+        (("plot",), ["LOG.mcap", "--sensor", "-o", "--from", "--to", "examples:"]),
     ],
     ids=["cosim", "modes", "run", "replay", "export", "info", "plot"],
 )
