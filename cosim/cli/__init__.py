@@ -15,7 +15,7 @@ from typing import Any
 from cosim.errors import interruption
 from cosim.run.signals import STOP_SIGNALS, install_stop_handlers
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "main", "report_interruption"]
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -33,17 +33,22 @@ def main(argv: list[str] | None = None) -> int:
 
         return app_main(argv)
     except KeyboardInterrupt as exc:  # during start-up, or anywhere the command did not handle it
-        signum, name = interruption(exc)
-        try:
-            print(f"cosim: interrupted ({name})", file=sys.stderr)
-        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
-            pass
-        return 128 + signum
+        return report_interruption(exc)
     finally:
         if threading.current_thread() is threading.main_thread():  # handlers can only be set there
             for signum, handler in previous.items():
                 if handler is not None:
                     signal.signal(signum, handler)
+
+
+def report_interruption(exc: KeyboardInterrupt) -> int:
+    """Say which signal stopped cosim (one line on stderr) and return its exit status, 128 + its number."""
+    signum, name = interruption(exc)
+    try:
+        print(f"cosim: interrupted ({name})", file=sys.stderr)
+    except (OSError, ValueError):  # SIGHUP: the terminal may be gone
+        pass
+    return 128 + signum
 
 
 def __getattr__(name: str) -> Any:

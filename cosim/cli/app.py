@@ -35,13 +35,14 @@ import sys
 import textwrap
 
 from cosim import __version__
-from cosim.errors import CosimError, interruption
+from cosim.errors import CosimError
 from cosim.log.schemas import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
 from cosim.plots import MAX_MODE_SHAPES
 from cosim.run.export import EXPORT_TOPICS
 from cosim.run.scenario import list_bundled_scenarios
 from cosim.run.static import STATIC_LOAD_N
 
+from . import report_interruption
 from .bridge import DEFAULT_COUNT, cmd_bridge
 from .dataset import cmd_dataset
 from .layout import cmd_layout
@@ -537,12 +538,7 @@ def main(argv: list[str] | None = None) -> int:
         report_error(str(exc))
         return EXIT_USAGE
     except KeyboardInterrupt as exc:  # SIGINT, SIGTERM or SIGHUP where the command did not report it itself
-        signum, name = interruption(exc)
-        try:
-            print(f"cosim: interrupted ({name})", file=sys.stderr)
-        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
-            pass
-        return 128 + signum
+        return report_interruption(exc)
     except BrokenPipeError:  # e.g. `cosim modes ... | head`
         try:
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - silence the flush at exit
