@@ -41,7 +41,7 @@ from cosim.log.schemas import (
     SCENARIO_ATTACHMENT,
     TOPIC_SENSORS,
 )
-from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
+from cosim.log.writer import BlockLogger, LogRecorder
 
 from .engineering import FatigueRecorder, fatigue_payload, stress_curves
 from .inputs import input_files
@@ -411,7 +411,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             scene.start()
         with BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene) as logger:
             if live_sumo:
-                traffic.frame_sink = TrafficLogger(rec)
+                traffic.frame_sink = logger.traffic_sink()
                 traffic.log_documents(rec.attach)
             result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
                               sensors=[*sensors, *(scene_sensors(plan) if plan is not None else [])], road=road,
