@@ -31,7 +31,7 @@ from cosim.run.scenario import load_scenario
 from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings, simulate
 from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks
-from cosim.log.writer import BlockLogger, LogRecorder, TrafficLogger
+from cosim.log.writer import BlockLogger, LogRecorder
 
 level, mode, minutes = sys.argv[1], sys.argv[2], float(sys.argv[3])
 duration = 60.0 * minutes
@@ -61,7 +61,7 @@ else:
         names = [s.name for s in sensors]
         with LogRecorder(path, names) as rec, BlockLogger(rec, names, duration) as lg:
             with SumoTraffic(cfg, axis, step=0.05, end=duration + 1, half_width=6.655,
-                             frame_sink=TrafficLogger(rec)) as tr:
+                             frame_sink=lg.traffic_sink()) as tr:
                 res = simulate(bridge, tr, duration, solver, sensors, output_every=2, observers=[lg], collect=False)
     else:
         with SumoTraffic(cfg, axis, step=0.05, end=duration + 1, half_width=6.655) as tr:

@@ -191,21 +191,24 @@ class _Extremes:
         self.s_max = np.zeros(len(names))
         self.force: dict[str, list[float]] = {}
         self.max_on_deck = 0
+        self._owners: tuple[tuple[str, ...], np.ndarray] = ((), np.zeros(0, dtype=np.int64))
 
     def on_block(self, times, keep, report) -> None:
         if len(report.sensors):
             values = report.sensors
-            low, high = values, values
-            if self.sparse:  # the steps a sensor was not read at do not count
-                unread = np.isnan(values)
-                low, high = np.where(unread, np.inf, values), np.where(unread, -np.inf, values)
-            self.s_min = np.minimum(self.s_min, low.min(axis=0))
-            self.s_max = np.maximum(self.s_max, high.max(axis=0))
+            if self.sparse:  # the steps a sensor was not read at (NaN) do not count: fmin/fmax skip NaN
+                self.s_min = np.fmin(self.s_min, np.fmin.reduce(values, axis=0))
+                self.s_max = np.fmax(self.s_max, np.fmax.reduce(values, axis=0))
+            else:
+                self.s_min = np.minimum(self.s_min, values.min(axis=0))
+                self.s_max = np.maximum(self.s_max, values.max(axis=0))
         if not report.ids:
             return
         # Vehicles, not contact points: the axles of one vehicle ("id#k") count once.
-        owners = np.array([vehicle_of(v) for v in report.ids])
-        _, col_owner = np.unique(owners, return_inverse=True)
+        if self._owners[0] != report.ids:  # the same vehicles block after block: worked out once
+            owners = np.array([vehicle_of(v) for v in report.ids])
+            self._owners = (report.ids, np.unique(owners, return_inverse=True)[1])
+        col_owner = self._owners[1]
         on_vehicle = np.zeros((len(report.on_deck), col_owner.max() + 1), dtype=bool)
         rows, cols = np.nonzero(report.on_deck)
         on_vehicle[rows, col_owner[cols]] = True
