@@ -87,6 +87,15 @@ def bundled_text() -> str:
     return textwrap.fill(f"SCENARIO is a path to a .toml file or the name of a bundled scenario ({names}).", 79)
 
 
+def _window_arguments(parser: argparse.ArgumentParser, verb: str) -> None:
+    """``--from T0`` and ``--to T1``: a window of simulated time (export and plot)."""
+    parser.add_argument("--from", dest="start", type=float, metavar="T0",
+                        help=f"{verb} from t = T0 s of simulated time (default: the log's start)")
+    parser.add_argument("--to", dest="end", type=float, metavar="T1",
+                        help=f"{verb} up to t = T1 s, included (default: the log's end)")
+    parser._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``cosim`` program."""
     formatter = argparse.RawDescriptionHelpFormatter
@@ -316,12 +325,8 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--topic", default=TOPIC_SENSORS, metavar="TOPIC",
                         help=f"the topic to export (one of: {topics}; default: {TOPIC_SENSORS})")
     # float, not finite_float: a time that is not finite is then the window check's one-line error.
-    export.add_argument("--from", dest="start", type=float, metavar="T0",
-                        help="export from t = T0 s of simulated time (default: the log's start)")
-    export.add_argument("--to", dest="end", type=float, metavar="T1",
-                        help="export up to t = T1 s, included (default: the log's end)")
+    _window_arguments(export, "export")
     export.add_argument("--force", "-f", action="store_true", help="overwrite OUT.csv if it exists")
-    export._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
     export.set_defaults(func=cmd_export)
 
     info = commands.add_parser(
@@ -367,12 +372,8 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("--sensor", action="append", metavar="NAME",
                       help="a sensor to draw (repeat for more; default: all)")
     plot.add_argument("-o", "--output", required=True, metavar="FIG.png", help="the figure (.png, .pdf, .svg, ...)")
-    plot.add_argument("--from", dest="start", type=float, metavar="T0",
-                      help="draw from t = T0 s of simulated time (default: the log's start)")
-    plot.add_argument("--to", dest="end", type=float, metavar="T1",
-                      help="draw up to t = T1 s, included (default: the log's end)")
+    _window_arguments(plot, "draw")
     plot.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
-    plot._negative_number_matcher = NEGATIVE_NUMBER  # "--from -5" is a value (see NEGATIVE_NUMBER)
     plot.set_defaults(func=cmd_plot)
 
     layout = commands.add_parser(
