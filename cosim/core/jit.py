@@ -49,7 +49,11 @@ def _install_core_locator() -> None:
 _install_core_locator()
 
 
-def compiled(func: Callable[..., Any] | None = None, *, nogil: bool = False) -> Any:
-    """``numba.njit(cache=True)`` (``nogil`` releases the GIL: for the block loops a log thread overlaps)."""
-    decorate = njit(cache=True, nogil=nogil)
+def compiled(func: Callable[..., Any] | None = None, *, nogil: bool = False, inline: bool = False) -> Any:
+    """``numba.njit(cache=True)`` (``nogil`` releases the GIL: for the block loops a log thread overlaps).
+
+    ``inline``: inlined into its callers (numba's ``inline="always"``), for the block loop's per-step
+    operations, which take records of many arrays: a call would pass and reference-count every one of them.
+    """
+    decorate = njit(cache=True, nogil=nogil, inline="always" if inline else "never")
     return decorate(func) if func is not None else decorate

@@ -123,7 +123,7 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 
 
 # ------------------------------------------------------------- contact rows
-@compiled
+@compiled(inline=True)
 def contact_rows(x, y, v, deck, elems, vals):  # noqa: ANN001, ANN201
     """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
 
@@ -170,7 +170,7 @@ def contact_rows(x, y, v, deck, elems, vals):  # noqa: ANN001, ANN201
 
 
 # ----------------------------------------------- basis-specific operations
-@compiled
+@compiled(inline=True)
 def internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha):  # noqa: ANN001, ANN201
     """rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n  (docs/theory.md (6.2)-(6.4))."""
     n = basis.n
@@ -207,7 +207,7 @@ def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
             rv[i, 2, kk] = vals[i, 2, k]
 
 
-@compiled
+@compiled(inline=True)
 def project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
     """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values.
 
@@ -242,7 +242,7 @@ def project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv):  # noqa: ANN
                     rv[i, 2, j] += c2_ * ph
 
 
-@compiled
+@compiled(inline=True)
 def solve(basis, b, x, counters):  # noqa: ANN001, ANN201
     """x = A^{-1} b with the once-factorised effective matrix (banded Cholesky, or a modal basis' diagonal)."""
     if basis.kind == DIRECT:
@@ -359,7 +359,7 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
 
 
 # --------------------------------------------------------- vehicle physics
-@compiled
+@compiled(inline=True)
 def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups):  # noqa: ANN001, ANN201
     """Every vehicle's predictors and deck-force coefficients: ``E_i = e0_i - (c0 n0 + c1 n1 + c2 n2)_i . a``."""
     dt, beta, gamma, alpha = scheme.dt, scheme.beta, scheme.gamma, scheme.alpha
@@ -389,7 +389,7 @@ def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, a
                                           e0, c0, c1, c2, aux)
 
 
-@compiled
+@compiled(inline=True)
 def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups):  # noqa: ANN001, ANN201
     """Advance the vehicles once the bridge acceleration is known; fills contact forces (N, compression
     positive) and the non-inertial deck forces (the HHT F_{n+1})."""
@@ -438,7 +438,7 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted,
 
 
 # ------------------------------------------------------------------- shared
-@compiled
+@compiled(inline=True)
 def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN201
     """d, v, a of the new step from the predictors and the new acceleration; False if it is not finite."""
     finite = True
@@ -451,7 +451,7 @@ def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN2
     return finite
 
 
-@compiled
+@compiled(inline=True)
 def _record(step, elems, contact, fleet, groups, out):  # noqa: ANN001, ANN201
     """The step's vehicle outputs, and lift-off: the one place where it is detected and counted (theory §5.7)."""
     counters = out.counters
