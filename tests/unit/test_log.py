@@ -272,3 +272,31 @@ def test_damage_in_a_finished_log_is_an_error_for_every_reader(tmp_path):
     for read in (read_log, open_log, lambda p: list(iter_messages(p, [TOPIC_SENSORS]))):
         with pytest.raises(LogError, match="corrupt MCAP file"):
             read(damaged)
+
+
+def test_sumo_frames_handed_to_the_writer_thread_are_all_written_in_order(tmp_path):
+    # The traffic sink only queues frames; the writer thread writes them with the next block, and close()
+    # writes those still waiting (a run stopped between two blocks must still replay to its last frame).
+    from cosim.core.coupling import BlockReport
+    from cosim.core.traffic import Frame
+    from cosim.log.reader import iter_messages
+    from cosim.log.schemas import TOPIC_TRAFFIC
+
+    model = QuarterCar(1e4, 1e3, 4e5, 2e4)
+    frames = [Frame(t=0.05 * k, ids=("car",), x=np.array([1.0 + k]), y=np.array([3.0]), v=np.array([20.0]),
+                    a=np.array([0.0]), types=("car",)) for k in range(1, 8)]
+    times = np.array([0.005, 0.01])
+    none = np.zeros((2, 0))
+    report = BlockReport((), (), none, np.zeros(0), none, none, none.astype(bool), none, none, none,
+                         np.zeros((2, 1)), none.astype(bool))
+    path = tmp_path / "frames.mcap"
+    with LogRecorder(path, ["s"]) as rec, BlockLogger(rec, ["s"], 1.0) as logger:
+        sink = logger.traffic_sink()
+        for frame in frames[:4]:  # handed over with the block below
+            sink(frame, {"car": model})
+        logger.on_block(times, np.array([True, True]), report)
+        for frame in frames[4:]:  # after the last block: written by close()
+            sink(frame, {"car": model})
+    got = [m for _, m in iter_messages(path, [TOPIC_TRAFFIC])]
+    assert [m["t"] for m in got] == [f.t for f in frames]
+    assert [m["x"] for m in got] == [[f.x[0]] for f in frames]
