@@ -738,6 +738,12 @@ class _Tally:
             self.last = max(self.last, last)
 
 
+#: What the record walk yields for the other records it passes on, by opcode.
+_RECORD_KINDS: dict[int, str] = {Opcode.CHUNK: "chunk", Opcode.HEADER: "header", Opcode.SCHEMA: "schema",
+                                  Opcode.ATTACHMENT: "attachment", Opcode.METADATA: "metadata",
+                                  Opcode.DATA_END: "data_end"}
+
+
 def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, tally: _Tally | None = None,
           window: tuple[int, int] | None = None, summary: _Summary | None = None, stats: ReadStats | None = None
           ) -> Iterator[tuple[str, Any]]:
@@ -776,18 +782,8 @@ def _walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, ta
             else:
                 wanted_ids.discard(record.id)
             yield "channel", record
-        elif opcode == Opcode.CHUNK:
-            yield "chunk", record
-        elif opcode == Opcode.HEADER:
-            yield "header", record
-        elif opcode == Opcode.SCHEMA:
-            yield "schema", record
-        elif opcode == Opcode.ATTACHMENT:
-            yield "attachment", record
-        elif opcode == Opcode.METADATA:
-            yield "metadata", record
-        elif opcode == Opcode.DATA_END:
-            yield "data_end", record
+        elif opcode in _RECORD_KINDS:
+            yield _RECORD_KINDS[opcode], record
     if first:
         _check_profile(path, None)
     yield "end", complete
