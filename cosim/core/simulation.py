@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import math
+import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, wait
@@ -35,6 +36,10 @@ from .traffic import TrafficBlock, TrafficSource, vehicle_of
 
 SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
+#: The interpreter's thread switch interval while a run overlaps traffic and solver, s. At Python's default
+#: (5 ms) the solver thread waited that long for the GIL to leave its compiled loop while the traffic thread
+#: (SUMO, the adapter) ran Python: the two threads took turns instead of overlapping (benchmarks/results/).
+SWITCH_INTERVAL = 5e-4
 #: Columns of :attr:`SimulationResult.vehicle_table`: the sample time, the vehicle's index, its fields.
 VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
@@ -317,9 +322,12 @@ def simulate(
         if progress is not None:
             progress(int(steps[-1]) / n_steps)
 
+    switch_interval = sys.getswitchinterval()
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="cosim-solver") as solver_thread:
         pending: tuple[Future[BlockReport], np.ndarray, np.ndarray] | None = None
         try:
+            if overlap:
+                sys.setswitchinterval(min(switch_interval, SWITCH_INTERVAL))
             done = 0
             while done < n_steps:
                 k = min(block_steps, n_steps - done)
@@ -338,6 +346,7 @@ def simulate(
                 finish(pending)
                 pending = None
         finally:
+            sys.setswitchinterval(switch_interval)
             if pending is not None:  # interrupted: let the block in flight end before the state is read
                 wait([pending[0]])
     if collector is not None:

@@ -33,6 +33,7 @@ from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
+from cosim.log.process import LogProcess, writer_process_possible
 from cosim.log.scene import ScenePlan, SceneWriter, plan_scene, scene_sensors, scene_wanted
 from cosim.log.schemas import (
     LAYOUT_ATTACHMENT,
@@ -57,6 +58,9 @@ FATIGUE_METADATA_NAME = "fatigue"
 LOGGED_MODES = 20
 #: How often a "running" status is logged, s of simulated time.
 STATUS_EVERY = 10.0
+#: Who encodes and writes the log: "process" (a child process, :mod:`cosim.log.process`), "thread" (a thread
+#: of the run's process), or "auto" (the process where that is possible, else the thread).
+LOG_WRITERS = ("auto", "process", "thread")
 
 
 class RunFailed(ModelError):
@@ -237,6 +241,7 @@ def run_logged(
     traffic: Any = None,
     duration: float | None = None,
     scene_by_default: bool = True,
+    writer: str = "auto",
 ) -> RunOutcome:
     """Run ``scenario``'s vehicles over its bridge and stream everything into the MCAP log ``log_path``.
 
@@ -267,6 +272,8 @@ def run_logged(
         traffic: a traffic source to use instead of the scenario's (replay of logged SUMO frames).
         duration: simulated time instead of the scenario's, s.
         scene_by_default: draw the 3D scene when ``[output].scene`` is unset (studies: no).
+        writer: who encodes and writes the log (:data:`LOG_WRITERS`): a child process keeps that work off
+            the GIL of the thread that runs SUMO; "auto" uses one on Linux in the main thread.
 
     Raises:
         RunInterrupted: a signal; ``log_path`` is the finished log (status "interrupted"), or None if
@@ -277,6 +284,12 @@ def run_logged(
     if not scenario.vehicles and scenario.traffic is None and traffic is None:
         raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
                           "nothing to simulate in time")
+    if writer not in LOG_WRITERS:
+        raise ConfigError(f"run_logged: `writer` must be one of {', '.join(LOG_WRITERS)} (got {writer!r})")
+    in_process = writer == "process" or (writer == "auto" and writer_process_possible())
+    if in_process and not writer_process_possible():
+        raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "
+                          "may start children; use \"thread\" or \"auto\"")
     started = started or datetime.datetime.now().astimezone()
     if bridge is None:
         bridge = scenario.build_bridge()
@@ -349,13 +362,13 @@ def run_logged(
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
         return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
-                       duration, every, rate_hz, meta, replay, documents, progress, plan)
+                       duration, every, rate_hz, meta, replay, documents, progress, plan, in_process)
 
 
 def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,
             live_sumo: bool, road: Any, solver: Any, sensors: list, duration: float, every: int, rate_hz: float,
             meta: dict[str, str], replay: dict[str, str] | None, documents: dict[str, bytes],
-            progress: Callable[[float], None] | None, plan: ScenePlan | None) -> RunOutcome:
+            progress: Callable[[float], None] | None, plan: ScenePlan | None, in_process: bool) -> RunOutcome:
     """The log itself: written under a temporary name until the stepping starts, then as ``log_path``."""
     names = [s.name for s in sensors]
     partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
@@ -374,7 +387,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             raise LogError(f"{log_path}: cannot create the log ({exc.strerror or exc})") from None
         state["started"] = True
 
-    rec: LogRecorder | None = None
+    rec: LogRecorder | LogProcess | None = None
 
     def discard() -> None:
         if rec is not None:
@@ -392,7 +405,8 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
 
     try:
         try:
-            rec = LogRecorder(partial, names, force=False, scene=plan is not None)
+            rec = (LogProcess(partial, names, scene=plan is not None) if in_process else
+                   LogRecorder(partial, names, force=False, scene=plan is not None))
         except LogError as exc:  # name the log the user asked for, not its temporary name
             raise LogError(str(exc).replace(str(partial), str(log_path))) from None
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
@@ -406,10 +420,15 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         rec.status(0.0, "started", f"{scenario.title}: {duration:g} s simulated, dt = {solver.dt:g} s, "
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
-        scene = SceneWriter(rec, plan, len(names)) if plan is not None else None
-        if scene is not None:
-            scene.start()
-        with BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene) as logger:
+        blocks: Any
+        if isinstance(rec, LogProcess):
+            blocks = rec.block_logger(duration, STATUS_EVERY, plan, len(names))
+        else:
+            scene = SceneWriter(rec, plan, len(names)) if plan is not None else None
+            if scene is not None:
+                scene.start()
+            blocks = BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene)
+        with blocks as logger:
             if live_sumo:
                 traffic.frame_sink = logger.traffic_sink()
                 traffic.log_documents(rec.attach)

@@ -25,6 +25,7 @@ from _cli import TWO_CARS, cli_env, cosim_cli
 
 import cosim
 from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES, read_log
+from cosim.log.process import ORPHANED
 from cosim.run.scenario import load_scenario
 from cosim.run.simulate import simulate_scenario
 from cosim.run.toml_writer import toml_dumps
@@ -251,7 +252,7 @@ def start_long_run(folder: Path) -> tuple[subprocess.Popen[str], Path]:
 
     proc = subprocess.Popen([sys.executable, "-m", "cosim", "run", str(scenario), "--out", str(log)],
                             cwd=folder, env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=default_sigint)
+                            preexec_fn=default_sigint, start_new_session=True)  # its group: the run, its log writer
     deadline = time.monotonic() + 60
     while not (log.exists() and log.stat().st_size > 600_000):  # a few chunks are on disk
         assert proc.poll() is None, proc.communicate()
@@ -262,7 +263,7 @@ def start_long_run(folder: Path) -> tuple[subprocess.Popen[str], Path]:
 
 def test_ctrl_c_leaves_a_finished_log_with_status_interrupted(tmp_path: Path) -> None:
     proc, log = start_long_run(tmp_path)
-    proc.send_signal(signal.SIGINT)
+    os.killpg(proc.pid, signal.SIGINT)  # as a terminal does: to the run and its log writer process
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, (out, err)
     assert "Traceback" not in err
@@ -274,9 +275,21 @@ def test_ctrl_c_leaves_a_finished_log_with_status_interrupted(tmp_path: Path) ->
     assert info.returncode == 0 and "Status: interrupted" in info.stdout and "Truncated: no" in info.stdout
 
 
-def test_sigkill_leaves_a_truncated_log_that_can_still_be_read(tmp_path: Path) -> None:
+def test_sigkill_of_the_run_leaves_a_log_its_writer_process_finishes(tmp_path: Path) -> None:
     proc, log = start_long_run(tmp_path)
-    proc.kill()
+    proc.kill()  # the run only (the out-of-memory killer's way): its log writer process finishes the file
+    proc.communicate(timeout=60)  # returns when the writer, which shares the run's output pipes, has ended too
+    assert proc.returncode == -signal.SIGKILL
+    contents = read_log(log)
+    assert not contents.truncated and contents.final_status["state"] == "error"
+    assert contents.final_status["message"] == ORPHANED
+    info = cosim_cli("info", str(log), cwd=tmp_path)
+    assert info.returncode == 0 and "Truncated: no" in info.stdout and ORPHANED in info.stdout, info.stdout
+
+
+def test_sigkill_of_the_whole_group_leaves_a_truncated_log_that_can_still_be_read(tmp_path: Path) -> None:
+    proc, log = start_long_run(tmp_path)
+    os.killpg(proc.pid, signal.SIGKILL)  # the run and its log writer: nothing finishes the file
     proc.communicate(timeout=60)
     assert proc.returncode == -signal.SIGKILL
     info = cosim_cli("info", str(log), cwd=tmp_path)

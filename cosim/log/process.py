@@ -1,0 +1,313 @@
+"""A run's log written by a child process: encoding and compression off the simulation's GIL.
+
+Encoding a run's log (JSON of every sample, the 3D scene, zstd chunks) is
+Python work. In a thread it took the GIL from the thread that runs SUMO and
+the adapter, which sets the pace of a run: logging was most of what a logged
+run cost over an unlogged one (benchmarks/results/day.md). Here a child
+process holds the :class:`cosim.log.writer.LogRecorder` (with its
+:class:`~cosim.log.writer.BlockLogger`, :class:`~cosim.log.writer.TrafficLogger`
+and :class:`~cosim.log.scene.SceneWriter`) and the run sends it what to write
+through a pipe: the same objects, so the file is the same as a thread would
+write it.
+
+:class:`LogProcess` has the recorder's methods (``attach``, ``metadata``,
+``write``, ``status``, ``flush``, ``close``) and :meth:`LogProcess.block_logger`
+gives the observer that streams the blocks. The child is forked (it starts in
+milliseconds with everything imported); it ignores the stop signals (SIGINT,
+SIGTERM, SIGHUP reach a whole process group: the run decides how its log
+ends), and when the run's process dies without closing the log (SIGKILL, the
+out-of-memory killer) the child still finishes it, with status "error" and
+:data:`ORPHANED`. An error in the child (a full disk) is raised in the run at
+its next block as a :class:`cosim.errors.LogError`.
+
+Only where forking is safe: Linux, the main thread of a process that may have
+children (:func:`writer_process_possible`); elsewhere runs log from a thread.
+"""
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import multiprocessing
+import signal
+import sys
+import threading
+import traceback
+from collections.abc import Iterable
+from multiprocessing.connection import Connection
+from pathlib import Path
+from typing import Any
+
+from cosim.errors import LogError
+
+__all__ = ["ORPHANED", "LogProcess", "writer_process_possible"]
+
+#: The final status message of a log whose run's process died before it closed the log.
+ORPHANED = "the run's process ended without finishing its log (killed, e.g. SIGKILL or out of memory)"
+#: Bytes the pipe to the child holds (Linux's F_SETPIPE_SZ; the default is 64 KiB, about one block): the run
+#: goes on while the child encodes a burst of blocks, and waits only when the child falls this far behind.
+PIPE_BYTES = 1 << 20
+#: How long closing waits for the child to finish the file, s.
+CLOSE_TIMEOUT = 120.0
+_F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)
+_STOPS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+def writer_process_possible() -> bool:
+    """Whether a log can be written by a forked child here: Linux, the main thread, a process allowed children."""
+    return (sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
+            and threading.current_thread() is threading.main_thread()
+            and not multiprocessing.current_process().daemon)
+
+
+def _first_line(exc: BaseException) -> str:
+    where = traceback.extract_tb(exc.__traceback__)
+    at = f" ({Path(where[-1].filename).name}:{where[-1].lineno})" if where else ""
+    return f"{type(exc).__name__}: {exc}{at}"
+
+
+def _child(commands: Connection, replies: Connection, parent_ends: tuple[Connection, ...], path: Path,
+           names: list[str], scene: bool) -> None:
+    """The child's loop: create the recorder, then do what the run sends until it says close (or dies)."""
+    for signum in _STOPS:  # blocked by the parent around the fork: ignored before they can arrive
+        signal.signal(signum, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
+    for end in parent_ends:  # else the run's death would not end the pipe (EOF) here
+        end.close()
+    from .scene import SceneWriter
+    from .writer import BlockLogger, LogRecorder, TrafficLogger
+
+    try:
+        rec = LogRecorder(path, names, force=False, scene=scene)
+    except BaseException as exc:  # noqa: BLE001 - reported to the run, which raises it
+        replies.send(("error", str(exc) if isinstance(exc, LogError) else _first_line(exc)))
+        return
+    replies.send(("ready", None))
+    logger: BlockLogger | None = None
+    traffic = TrafficLogger(rec)
+    models: dict[str, Any] = {}
+    error: str | None = None
+    while True:
+        try:
+            message = commands.recv()
+        except (EOFError, OSError):  # the run's process is gone: finish the file for whoever reads it
+            with contextlib.suppress(BaseException):
+                rec.close("error", ORPHANED)
+            return
+        op = message[0]
+        if op == "close":
+            try:
+                if logger is not None and error is None:
+                    logger.close()
+                rec.close(*message[1:])
+            except BaseException as exc:  # noqa: BLE001
+                error = error or _first_line(exc)
+            replies.send(("closed", error))
+            return
+        if error is not None:
+            continue  # the first error is reported; the rest is read and dropped so that the run never blocks
+        try:
+            if op == "block":
+                _, times, keep, report, frames, new_models = message
+                models.update(new_models)
+                for frame in frames:
+                    traffic.write_frame(frame, models)
+                if times is not None and logger is not None:
+                    logger.on_block(times, keep, report)
+            elif op == "logger":
+                _, total_time, status_every, plan, first_column = message
+                scene_writer = SceneWriter(rec, plan, first_column) if plan is not None else None
+                if scene_writer is not None:
+                    scene_writer.start()
+                logger = BlockLogger(rec, names, total_time, status_every=status_every, threaded=False,
+                                     scene=scene_writer)
+            else:
+                getattr(rec, op)(*message[1:])
+        except BaseException as exc:  # noqa: BLE001 - reported to the run at its next block
+            error = _first_line(exc)
+            with contextlib.suppress(OSError):
+                replies.send(("error", error))
+
+
+class LogProcess:
+    """A :class:`cosim.log.writer.LogRecorder` in a child process (same arguments but ``chunk_size``).
+
+    Raises:
+        LogError: the child could not create the file (the recorder's own message).
+    """
+
+    def __init__(self, path: str | Path, sensor_names: Iterable[str], scene: bool = False) -> None:
+        self.path = Path(path)
+        self.sensor_names = list(sensor_names)
+        self.final_state: str | None = None
+        self._closed = False
+        self._error: str | None = None
+        context = multiprocessing.get_context("fork")
+        commands_in, commands_out = context.Pipe(duplex=False)
+        replies_in, replies_out = context.Pipe(duplex=False)
+        with contextlib.suppress(OSError):  # a smaller pipe only makes the run wait sooner
+            fcntl.fcntl(commands_out.fileno(), _F_SETPIPE_SZ, PIPE_BYTES)
+        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+        try:
+            self._process = context.Process(
+                target=_child, name="cosim-log-writer", daemon=False,
+                args=(commands_in, replies_out, (commands_out, replies_in), self.path, self.sensor_names, scene))
+            self._process.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+        commands_in.close()
+        replies_out.close()
+        self._commands, self._replies = commands_out, replies_in
+        kind, text = self._reply()
+        if kind != "ready":
+            self._process.join(CLOSE_TIMEOUT)
+            self._closed = True
+            raise LogError(text or f"{self.path}: the log writer process failed to start")
+        self._sent_types: set[str] = set()
+
+    def _reply(self) -> tuple[str, str | None]:
+        try:
+            return self._replies.recv()
+        except (EOFError, OSError):
+            return "error", f"{self.path}: the log writer process ended unexpectedly " \
+                            f"(exit status {self._process.exitcode})"
+
+    def _send(self, *message: Any) -> None:
+        if self._closed:
+            raise LogError(f"{self.path}: the log is already closed")
+        self.check()
+        try:
+            self._commands.send(message)
+        except OSError as exc:
+            raise LogError(f"{self.path}: the log writer process is gone ({exc.strerror or exc})") from None
+
+    def check(self) -> None:
+        """Raise the child's first error (e.g. a full disk), if it reported one."""
+        while self._error is None and self._replies.poll():
+            kind, text = self._reply()
+            if kind == "error":
+                self._error = text
+        if self._error is not None:
+            raise LogError(f"{self.path}: writing the log failed: {self._error}")
+
+    # ------------------------------------------------- the recorder's methods
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        self._send("attach", name, data, media_type)
+
+    def metadata(self, name: str, values: dict[str, str]) -> None:
+        self._send("metadata", name, dict(values))
+
+    def write(self, topic: str, t: float, message: dict[str, Any]) -> None:
+        self._send("write", topic, t, message)
+
+    def status(self, t: float, state: str, message: str = "", progress: float | None = None,
+               wall_time: float | None = None) -> None:
+        self._send("status", t, state, message, progress, wall_time)
+
+    def flush(self) -> None:
+        self._send("flush")
+
+    def close(self, state: str = "finished", message: str = "", wall_time: float | None = None) -> None:
+        """Finish the log (its last status ``state``) and wait for the child; idempotent.
+
+        Raises:
+            LogError: the child failed to write (its first error), or did not finish in time.
+        """
+        if self._closed:
+            return
+        self._closed = True
+        self.final_state = state
+        error = self._error
+        try:
+            self._commands.send(("close", state, message, wall_time))
+            while True:
+                kind, text = self._reply()
+                if kind == "closed":
+                    error = error or text
+                    break
+                if kind == "error":
+                    error = error or text
+                    if text and "ended unexpectedly" in text:
+                        break
+        except OSError as exc:
+            error = error or f"the log writer process is gone ({exc})"
+        finally:
+            self._commands.close()
+            self._process.join(CLOSE_TIMEOUT)
+            if self._process.is_alive():
+                self._process.kill()
+                self._process.join()
+                error = error or f"the log writer process did not finish within {CLOSE_TIMEOUT:g} s"
+            self._replies.close()
+        if error is not None:
+            raise LogError(f"{self.path}: writing the log failed: {error}")
+
+    # ------------------------------------------------------ the block stream
+    def block_logger(self, total_time: float, status_every: float, plan: Any = None,
+                     first_column: int = 0) -> _BlockStream:
+        """The observer of :func:`cosim.core.simulation.simulate` that streams the blocks into this log.
+
+        The child writes them with a :class:`cosim.log.writer.BlockLogger` (and draws ``plan``'s scene,
+        :class:`cosim.log.scene.SceneWriter`, from the sensor columns from ``first_column`` on).
+        """
+        self._send("logger", total_time, status_every, plan, first_column)
+        return _BlockStream(self)
+
+
+class _BlockStream:
+    """:class:`cosim.log.writer.BlockLogger`'s interface on the run's side of a :class:`LogProcess`."""
+
+    def __init__(self, log: LogProcess) -> None:
+        self.log = log
+        self._frames: list[Any] = []
+        self._new_models: dict[str, Any] = {}
+        self._known: set[str] = set()
+
+    def on_block(self, times, keep, report) -> None:  # noqa: ANN001 - the simulate() observer protocol
+        self._hand_over(times, keep, report)
+
+    def _hand_over(self, times, keep, report) -> None:  # noqa: ANN001
+        frames, self._frames = self._frames, []
+        models, self._new_models = self._new_models, {}
+        self.log._send("block", times, keep, report, frames, models)
+
+    def traffic_sink(self) -> _FrameSink:
+        """A frame sink for a live traffic source (SUMO): its frames go to the child with the next block."""
+        return _FrameSink(self)
+
+    def paced(self, traffic: Any) -> Any:
+        return traffic  # the child does not share the run's GIL: nothing to pace
+
+    def close(self) -> None:
+        """Hand over the frames still waiting; raise the child's first error."""
+        if self._frames and not self.log._closed:
+            self._hand_over(None, None, None)
+        self.log.check()
+
+    def __enter__(self) -> _BlockStream:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> None:  # noqa: ANN001
+        try:
+            self.close()
+        except LogError:
+            if exc_type is None:
+                raise
+
+
+class _FrameSink:
+    """Collects SUMO frames (and each vehicle type's model, once) for the child."""
+
+    def __init__(self, stream: _BlockStream) -> None:
+        self.stream = stream
+
+    def __call__(self, frame, models: dict) -> None:  # noqa: ANN001 - the adapter's frame sink protocol
+        stream = self.stream
+        stream._frames.append(frame)
+        for typ in frame.types:
+            if typ not in stream._known:
+                stream._known.add(typ)
+                stream._new_models[typ] = models[typ]
+
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""
+        self.stream.log.attach(name, data, media_type)

@@ -1,0 +1,95 @@
+"""The log written by a child process (cosim.log.process): real forks, real pipes, real MCAP files."""
+from __future__ import annotations
+
+import datetime
+import threading
+from pathlib import Path
+
+import pytest
+import tomllib
+from mcap.reader import make_reader
+
+from cosim.errors import ConfigError, LogError
+from cosim.log import TOPIC_SENSORS, TOPIC_STATUS, read_log
+from cosim.log.process import LogProcess, writer_process_possible
+from cosim.run.logged import run_logged
+from cosim.run.scenario import load_scenario, parse_scenario
+from cosim.run.toml_writer import toml_dumps
+
+STARTED = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
+#: SUMO's messages name its scratch folder (a new one per run): not compared.
+SCRATCH_NAMED = {"sumo-messages.log"}
+
+pytestmark = pytest.mark.skipif(not writer_process_possible(), reason="the log writer process needs Linux and fork")
+
+
+def log_records(path: Path) -> tuple[list, list, list]:
+    """Every message but the status (whose wall times differ), every attachment, every metadata record."""
+    with open(path, "rb") as fh:
+        reader = make_reader(fh)
+        messages = sorted((channel.topic, m.log_time, m.data) for _, channel, m in reader.iter_messages()
+                          if channel.topic != TOPIC_STATUS)
+        attachments = sorted((a.name, a.data) for a in reader.iter_attachments() if a.name not in SCRATCH_NAMED)
+        metadata = sorted((m.name, sorted(m.metadata.items())) for m in reader.iter_metadata())
+    return messages, attachments, metadata
+
+
+@pytest.mark.parametrize("name, end", [("paper-double-tee", None), ("paper-bridge-traffic", 20.0)])
+def test_the_process_writes_the_same_log_as_the_thread(tmp_path: Path, name: str, end: float | None) -> None:
+    base = load_scenario(name)
+    data = tomllib.loads(base.text)
+    if end is not None:  # SUMO: 20 s of traffic, the 3D scene and the SUMO frames included
+        data["traffic"]["end"] = end
+    scenario = parse_scenario(toml_dumps(data), name, base_dir=base.base_dir)
+    bridge = scenario.build_bridge()
+    logs = {}
+    for writer in ("thread", "process"):
+        logs[writer] = tmp_path / f"{writer}.mcap"
+        run_logged(scenario, logs[writer], bridge=bridge, writer=writer, started=STARTED)
+    thread, process = log_records(logs["thread"]), log_records(logs["process"])
+    assert len(thread[0]) > 100  # a run's worth of messages, not an empty comparison
+    assert process == thread  # same objects encode the same messages: byte for byte
+    assert read_log(logs["process"]).final_status["state"] == "finished"
+
+
+def test_an_error_in_the_writer_process_is_raised_in_the_run_and_the_log_still_ends(tmp_path: Path) -> None:
+    log = LogProcess(tmp_path / "run.mcap", ["mid"])
+    log.write(TOPIC_SENSORS, 0.0, {"t": 0.0, "mid": 0.0})
+    log.write("/no/such/topic", 0.1, {"t": 0.1})  # the child's recorder has no channel for it: KeyError there
+    with pytest.raises(LogError, match=r"run\.mcap: writing the log failed: KeyError: '/no/such/topic'"):
+        for _ in range(200):  # the child reports asynchronously: the run hears of it at a later message
+            log.flush()
+            threading.Event().wait(0.01)
+    with pytest.raises(LogError, match="writing the log failed: KeyError"):
+        log.close("error", "stopped")
+    contents = read_log(tmp_path / "run.mcap")
+    assert not contents.truncated and contents.final_status["message"] == "stopped"
+    assert len(contents.topic(TOPIC_SENSORS)) == 1
+
+
+def test_a_log_the_process_cannot_create_is_the_recorders_error(tmp_path: Path) -> None:
+    taken = tmp_path / "taken.mcap"
+    taken.write_bytes(b"someone's file")
+    with pytest.raises(LogError, match=r"taken\.mcap: exists; refusing to overwrite a log \(use --force\)"):
+        LogProcess(taken, ["mid"])
+    assert taken.read_bytes() == b"someone's file"
+
+
+def test_the_writer_argument_is_checked(tmp_path: Path) -> None:
+    scenario = load_scenario("paper-double-tee")
+    with pytest.raises(ConfigError, match=r"`writer` must be one of auto, process, thread \(got 'fork'\)"):
+        run_logged(scenario, tmp_path / "a.mcap", writer="fork")
+    errors: list[BaseException] = []
+
+    def in_a_thread() -> None:
+        try:
+            run_logged(scenario, tmp_path / "b.mcap", writer="process")
+        except BaseException as exc:  # noqa: BLE001 - checked below, in the test's thread
+            errors.append(exc)
+
+    worker = threading.Thread(target=in_a_thread)
+    worker.start()
+    worker.join()
+    assert len(errors) == 1 and isinstance(errors[0], ConfigError)
+    assert "needs Linux and the main thread" in str(errors[0])
+    assert not (tmp_path / "a.mcap").exists() and not (tmp_path / "b.mcap").exists()
