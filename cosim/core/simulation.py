@@ -10,6 +10,7 @@ path off the deck, or a non-finite setting are errors that name the culprit.
 """
 from __future__ import annotations
 
+import collections
 import csv
 import math
 import sys
@@ -39,7 +40,7 @@ BASES: tuple[str, ...] = ("direct", "modal")
 #: The interpreter's thread switch interval while a run overlaps traffic and solver, s. At Python's default
 #: (5 ms) the solver thread waited that long for the GIL to leave its compiled loop while the traffic thread
 #: (SUMO, the adapter) ran Python: the two threads took turns instead of overlapping (benchmarks/results/).
-SWITCH_INTERVAL = 5e-4
+SWITCH_INTERVAL = 1e-4
 #: Columns of :attr:`SimulationResult.vehicle_table`: the sample time, the vehicle's index, its fields.
 VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
@@ -322,9 +323,23 @@ def simulate(
         if progress is not None:
             progress(int(steps[-1]) / n_steps)
 
+    failed: list[BaseException] = []
+
+    def advance(block: TrafficBlock) -> BlockReport:
+        if failed:  # a block queued behind one that failed (diverged) does not run on its state
+            raise failed[0]
+        try:
+            return system.advance(block)
+        except BaseException as exc:
+            failed.append(exc)
+            raise
+
+    # Two blocks in flight: the worker starts the next block as soon as it ends one, while this thread shows
+    # the one before to the observers (the log) and asks the traffic for the one after. The worker takes them
+    # in order, so the numbers are those of one block at a time.
+    in_flight: collections.deque[tuple[Future[BlockReport], np.ndarray, np.ndarray]] = collections.deque()
     switch_interval = sys.getswitchinterval()
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="cosim-solver") as solver_thread:
-        pending: tuple[Future[BlockReport], np.ndarray, np.ndarray] | None = None
         try:
             if overlap:
                 sys.setswitchinterval(min(switch_interval, SWITCH_INTERVAL))
@@ -333,22 +348,18 @@ def simulate(
                 k = min(block_steps, n_steps - done)
                 steps = np.arange(done + 1, done + k + 1)
                 times = steps * solver.dt
-                block = traffic.block(times)  # while the worker advances the previous block
-                if pending is not None:
-                    finish(pending)
-                    pending = None
-                pending = (solver_thread.submit(system.advance, block), steps, times)
-                if not overlap:
-                    finish(pending)
-                    pending = None
+                block = traffic.block(times)  # while the worker advances the blocks before
+                in_flight.append((solver_thread.submit(advance, block), steps, times))
+                while len(in_flight) > (1 if overlap else 0):
+                    finish(in_flight.popleft())
                 done += k
-            if pending is not None:
-                finish(pending)
-                pending = None
+            while in_flight:
+                finish(in_flight.popleft())
         finally:
             sys.setswitchinterval(switch_interval)
-            if pending is not None:  # interrupted: let the block in flight end before the state is read
-                wait([pending[0]])
+            # Interrupted: blocks not begun are dropped; the one running ends before the state is read.
+            running = [future for future, _, _ in in_flight if not future.cancel()]
+            wait(running)
     if collector is not None:
         vehicle_table = {k: (np.concatenate(v) if v else np.zeros(0)) for k, v in collector.table.items()}
         vehicle_table["vehicle"] = vehicle_table["vehicle"].astype(np.int64)
