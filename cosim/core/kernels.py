@@ -25,6 +25,7 @@ computed.
 from __future__ import annotations
 
 from collections import namedtuple
+from typing import Any
 
 import numpy as np
 
@@ -41,11 +42,13 @@ NODE_SNAP = 1e-12
 #: kind: DIRECT | MODAL; n: unknowns.
 #: Direct: factor (n, bw+1) banded Cholesky factor by rows; K and M in CSR (k_ptr, k_ind, k_dat, m_ptr,
 #: m_ind, m_dat); Rayleigh ray_a, ray_b; inverse (n, n) of the effective matrix; reduced: full DOF ->
-#: unknown (-1 restrained). Modal: phi (ndof, n) mass-normalised modes; c_diag, k_diag, a_inv (n,).
+#: unknown (-1 restrained). Modal: phi (ndof, n) mass-normalised modes; c_diag, k_diag, a_inv (n,); poly_w,
+#: poly_t (n_el, 4, n): on each element, every mode's w and theta_x at the deck as cubics in xi
+#: (:func:`modal_polynomials`; empty until the coupled system sets them).
 BasisArrays = namedtuple("BasisArrays", [
     "kind", "n", "factor", "k_ptr", "k_ind", "k_dat", "m_ptr", "m_ind", "m_dat", "ray_a", "ray_b", "inverse",
-    "reduced", "phi", "c_diag", "k_diag", "a_inv",
-])
+    "reduced", "phi", "c_diag", "k_diag", "a_inv", "poly_w", "poly_t",
+], defaults=(np.zeros((0, 0, 0)), np.zeros((0, 0, 0))))
 #: The deck: node positions (m), per-element polynomial coefficients of w and theta_x (n_el, 14, 4), the
 #: shear centre's y (m), the length (m), and the element DOFs a deck point's w depends on (from the element).
 DeckArrays = namedtuple("DeckArrays", ["nodes_x", "cw", "ct", "y_s", "length", "dofs", "node_dofs"])
@@ -123,9 +126,28 @@ def csr_matvec_add(indptr, indices, data, x, out, scale):  # noqa: ANN001, ANN20
 
 
 # ------------------------------------------------------------- contact rows
+def modal_polynomials(phi: np.ndarray, deck: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Every mode's deck w (at the shear centre) and theta_x on each element as cubics in xi: (n_el, 4, n) each.
+
+    A contact row in modal coordinates is then, per mode, a cubic evaluated
+    at the contact point (13 multiply-adds with w_x and w_xx) instead of a sum
+    over the element's eight deck DOFs (24): the projection was most of a
+    modal step's cost per vehicle (benchmarks/bench_step.py).
+    """
+    dofs = np.asarray(deck.dofs)
+    n_el = deck.cw.shape[0]
+    rows = deck.node_dofs * np.arange(n_el)[:, None] + dofs[None, :]  # (n_el, deck DOFs): full DOF numbers
+    shapes = phi[rows]  # (n_el, deck DOFs, n)
+    poly_w = np.einsum("ekp,ekj->epj", deck.cw[:, dofs, :], shapes)
+    poly_t = np.einsum("ekp,ekj->epj", deck.ct[:, dofs, :], shapes)
+    return np.ascontiguousarray(poly_w), np.ascontiguousarray(poly_t)
+
+
 @compiled(inline=True)
-def contact_rows(x, y, v, deck, elems, vals):  # noqa: ANN001, ANN201
+def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
     """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
+
+    ``geo[i]``: the point's xi on its element, its lever y - y_s (m) and the element's length (m).
 
     docs/theory.md §5.1. At a node, w_xx of the cubic elements jumps: a contact
     point exactly on a node takes the element ahead of it in its direction of
@@ -167,6 +189,7 @@ def contact_rows(x, y, v, deck, elems, vals):  # noqa: ANN001, ANN201
             vals[i, 1, k] = s1
             vals[i, 2, k] = s2
         elems[i] = e
+        geo[i, 0], geo[i, 1], geo[i, 2] = xi, lever, L
 
 
 # ----------------------------------------------- basis-specific operations
@@ -208,38 +231,43 @@ def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
 
 
 @compiled(inline=True)
-def project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
+def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
     """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values.
 
-    A complete modal engine (``basis.inverse`` given) also keeps the physical rows
-    (``pidx``, ``prv``) for the capacitance matrix.
+    On a modal basis each mode's w, w_x, w_xx at the point come from its cubics
+    on the element (:func:`modal_polynomials`). A complete modal engine
+    (``basis.inverse`` given) also keeps the physical rows (``pidx``, ``prv``)
+    for the capacitance matrix.
     """
     q = elems.shape[0]
-    dofs = deck.dofs
     if basis.kind == DIRECT:
         _physical_rows(basis, deck, elems, vals, idx, rv)
     else:
         if basis.inverse.shape[0] > 0:
             _physical_rows(basis, deck, elems, vals, pidx, prv)
         m = basis.n
+        pw, pt = basis.poly_w, basis.poly_t
         for i in range(q):
             for j in range(m):
                 idx[i, j] = j
-                rv[i, 0, j] = 0.0
-                rv[i, 1, j] = 0.0
-                rv[i, 2, j] = 0.0
             e = elems[i]
             if e < 0:
-                continue
-            for kk in range(dofs.shape[0]):
-                k = dofs[kk]
-                dof = deck.node_dofs * e + k
-                c0_, c1_, c2_ = vals[i, 0, k], vals[i, 1, k], vals[i, 2, k]
                 for j in range(m):
-                    ph = basis.phi[dof, j]
-                    rv[i, 0, j] += c0_ * ph
-                    rv[i, 1, j] += c1_ * ph
-                    rv[i, 2, j] += c2_ * ph
+                    rv[i, 0, j] = 0.0
+                    rv[i, 1, j] = 0.0
+                    rv[i, 2, j] = 0.0
+                continue
+            xi, lever, L = geo[i, 0], geo[i, 1], geo[i, 2]
+            xi2 = xi * xi
+            d1, d2 = 1.0 / L, 1.0 / (L * L)
+            for j in range(m):
+                a0 = pw[e, 0, j] + lever * pt[e, 0, j]
+                a1 = pw[e, 1, j] + lever * pt[e, 1, j]
+                a2 = pw[e, 2, j] + lever * pt[e, 2, j]
+                a3 = pw[e, 3, j] + lever * pt[e, 3, j]
+                rv[i, 0, j] = a0 + a1 * xi + a2 * xi2 + a3 * xi2 * xi
+                rv[i, 1, j] = (a1 + 2.0 * a2 * xi + 3.0 * a3 * xi2) * d1
+                rv[i, 2, j] = (2.0 * a2 + 6.0 * a3 * xi) * d2
 
 
 @compiled(inline=True)
@@ -296,6 +324,35 @@ def _capacitance(ainv, idx, rv, p, groups, S):  # noqa: ANN001, ANN201
             S[i, jv] = s
 
 
+@compiled(inline=True)
+def solve_small(S, b):  # noqa: ANN001, ANN201
+    """b <- S^{-1} b for the small capacitance matrix (q x q), by Gaussian elimination with partial pivoting in
+    place (S is overwritten). LAPACK's solve allocated and cost more than the elimination for the few
+    vehicles on a deck (about 2 us a step; benchmarks/bench_step.py)."""
+    q = b.shape[0]
+    for c in range(q):
+        pivot = c
+        for r in range(c + 1, q):
+            if abs(S[r, c]) > abs(S[pivot, c]):
+                pivot = r
+        if pivot != c:
+            for k in range(c, q):
+                S[c, k], S[pivot, k] = S[pivot, k], S[c, k]
+            b[c], b[pivot] = b[pivot], b[c]
+        inv = 1.0 / S[c, c]
+        for r in range(c + 1, q):
+            f = S[r, c] * inv
+            if f != 0.0:
+                for k in range(c + 1, q):
+                    S[r, k] -= f * S[c, k]
+                b[r] -= f * b[c]
+    for r in range(q - 1, -1, -1):
+        acc = b[r]
+        for k in range(r + 1, q):
+            acc -= S[r, k] * b[k]
+        b[r] = acc / S[r, r]
+
+
 @compiled
 def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pidx, prv, pp):  # noqa: ANN001, ANN201
     """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
@@ -317,7 +374,8 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
             pz[i] = s
         _capacitance(basis.inverse, idx, rv, p, groups, S)
         _mix_groups(groups, S, pz)
-        sol = np.linalg.solve(S, pz)
+        solve_small(S, pz)
+        sol = pz
         for j in range(us.shape[0]):
             us[j] = 0.0
         for i in range(q):
@@ -350,7 +408,8 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
                         s += p[i, j] * (a_inv[j] * rv[k, 0, j])
                     S[i, k] = s
         _mix_groups(groups, S, pz)
-        sol = np.linalg.solve(S, pz)
+        solve_small(S, pz)
+        sol = pz
         for j in range(m):
             c = 0.0
             for k in range(q):
@@ -507,6 +566,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     z_b = np.empty(n)
     elems = np.empty(q, dtype=np.int64)
     vals = np.empty((q, 3, deck.cw.shape[1]))
+    geo = np.empty((q, 3))
     rhs_bridge = np.empty(n)
     tau0 = np.empty(q)
     tau1 = np.empty(q)
@@ -522,19 +582,27 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
         internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
-        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals)
-        project_contacts(basis, deck, elems, vals, idx, rv, pidx, prv)
+        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals, geo)
+        project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
             s0 = s1 = s2 = s3 = s4 = 0.0
-            for kk in range(nnz):
-                j = idx[i, kk]
-                if j >= 0:
-                    s0 += rv[i, 0, kk] * d_star[j]
-                    s1 += rv[i, 1, kk] * d_star[j]
-                    s2 += rv[i, 0, kk] * v_star[j]
-                    s3 += rv[i, 2, kk] * d_star[j]
-                    s4 += rv[i, 1, kk] * v_star[j]
+            if basis.kind == MODAL:  # every mode, in order: no index to follow (the loop vectorises)
+                for j in range(nnz):
+                    s0 += rv[i, 0, j] * d_star[j]
+                    s1 += rv[i, 1, j] * d_star[j]
+                    s2 += rv[i, 0, j] * v_star[j]
+                    s3 += rv[i, 2, j] * d_star[j]
+                    s4 += rv[i, 1, j] * v_star[j]
+            else:
+                for kk in range(nnz):
+                    j = idx[i, kk]
+                    if j >= 0:
+                        s0 += rv[i, 0, kk] * d_star[j]
+                        s1 += rv[i, 1, kk] * d_star[j]
+                        s2 += rv[i, 0, kk] * v_star[j]
+                        s3 += rv[i, 2, kk] * d_star[j]
+                        s4 += rv[i, 1, kk] * v_star[j]
             dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = s0, s1, s2, s3, s4
         if groups.unilateral:
             for j in range(n):
@@ -545,6 +613,11 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                     rhs[j] = rhs_bridge[j]
             vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups)
             for i in range(q):
+                if basis.kind == MODAL:
+                    for j in range(nnz):
+                        p[i, j] = c0[i] * rv[i, 0, j] + c1[i] * rv[i, 1, j] + c2[i] * rv[i, 2, j]
+                        rhs[j] += rv[i, 0, j] * e0[i]
+                    continue
                 for kk in range(nnz):
                     j = idx[i, kk]
                     p[i, kk] = c0[i] * rv[i, 0, kk] + c1[i] * rv[i, 1, kk] + c2[i] * rv[i, 2, kk]
@@ -582,15 +655,24 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
         # Deck motion at the contact points after the step: n0.a, n1.a, n2.a, n0.d, n0.v + v n1.d.
         for i in range(q):
             s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-            for kk in range(nnz):
-                j = idx[i, kk]
-                if j >= 0:
-                    s0 += rv[i, 0, kk] * a[j]
-                    s1 += rv[i, 1, kk] * a[j]
-                    s2 += rv[i, 2, kk] * a[j]
-                    s3 += rv[i, 0, kk] * d[j]
-                    s4 += rv[i, 0, kk] * v[j]
-                    s5 += rv[i, 1, kk] * d[j]
+            if basis.kind == MODAL:
+                for j in range(nnz):
+                    s0 += rv[i, 0, j] * a[j]
+                    s1 += rv[i, 1, j] * a[j]
+                    s2 += rv[i, 2, j] * a[j]
+                    s3 += rv[i, 0, j] * d[j]
+                    s4 += rv[i, 0, j] * v[j]
+                    s5 += rv[i, 1, j] * d[j]
+            else:
+                for kk in range(nnz):
+                    j = idx[i, kk]
+                    if j >= 0:
+                        s0 += rv[i, 0, kk] * a[j]
+                        s1 += rv[i, 1, kk] * a[j]
+                        s2 += rv[i, 2, kk] * a[j]
+                        s3 += rv[i, 0, kk] * d[j]
+                        s4 += rv[i, 0, kk] * v[j]
+                        s5 += rv[i, 1, kk] * d[j]
             dots[5, i], dots[6, i], dots[7, i], dots[8, i] = s0, s1, s2, s3
             dots[9, i] = s4 + kin.v[step, i] * s5
         vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups)

@@ -32,6 +32,7 @@ import signal
 import sys
 import threading
 import traceback
+import weakref
 from collections.abc import Iterable
 from multiprocessing.connection import Connection
 from pathlib import Path
@@ -73,6 +74,13 @@ def _child(commands: Connection, replies: Connection, parent_ends: tuple[Connect
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
     for end in parent_ends:  # else the run's death would not end the pipe (EOF) here
         end.close()
+    # Whatever happens here is the run's to report (through the replies) or nobody's: a run that stopped
+    # before the log was ready has closed its end, and the terminal must not get this process' traceback.
+    with contextlib.suppress(BaseException):
+        _serve(commands, replies, path, names, scene)
+
+
+def _serve(commands: Connection, replies: Connection, path: Path, names: list[str], scene: bool) -> None:
     from .scene import SceneWriter
     from .writer import BlockLogger, LogRecorder, TrafficLogger
 
@@ -157,7 +165,18 @@ class LogProcess:
         commands_in.close()
         replies_out.close()
         self._commands, self._replies = commands_out, replies_in
-        kind, text = self._reply()
+        # At the run's exit the pipe closes even if the log was not (a defect): the child then finishes the
+        # file (ORPHANED) and ends, instead of waiting for commands while multiprocessing waits for it.
+        weakref.finalize(self, commands_out.close)
+        try:
+            kind, text = self._reply()
+        except BaseException:  # a stop signal while the child starts: it is stopped before the run cleans up
+            self._closed = True
+            self._process.kill()
+            self._process.join()
+            commands_out.close()
+            replies_in.close()
+            raise
         if kind != "ready":
             self._process.join(CLOSE_TIMEOUT)
             self._closed = True

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from cosim.core import kernels
 from cosim.core.bases import DirectBasis, make_basis
 from cosim.core.bridge import ExplicitDamping, build_bridge
 from cosim.core.coupling import CoupledSystem
@@ -295,3 +296,48 @@ def test_a_sensor_read_every_nth_step_is_the_same_numbers_at_those_steps(basis):
     assert run.sensor_max["acc_every_7"] == max(np.max(run.sensors["acc"][read]), 0.0)
     with pytest.raises(ConfigError, match="sensor s: `every` must be an integer >= 1"):
         Sensor("s", 1.0, every=0)
+
+
+@pytest.mark.parametrize("basis_name", ["modal", "complete"])
+def test_modal_contact_rows_from_the_element_cubics_equal_the_projection_of_the_deck_dofs(basis_name):
+    """kernels.project_contacts evaluates each mode's cubics on the element (modal_polynomials); the reference
+    is the definition: the physical row's values at the element's deck DOFs times the mode shapes there."""
+    bridge = _bridge()
+    basis = make_basis(bridge, 2e-3, Scheme.newmark(), "modal" if basis_name == "modal" else "direct",
+                       20 if basis_name == "modal" else None, None)
+    system = CoupledSystem(bridge, basis, Scheme.newmark(), 2e-3)
+    arrays = system._engines["basis" if basis_name == "modal" else "complete-modal"][0]
+    deck = system._deck
+    rng = np.random.default_rng(7)
+    x = np.concatenate([rng.uniform(0.0, 30.0, 9), bridge.nodes_x[[0, 5, 12]], [-1.0]])  # nodes, and off the deck
+    y = rng.uniform(-2.0, 2.0, len(x))
+    q, n = len(x), arrays.n
+    elems, vals, geo = np.zeros(q, dtype=np.int64), np.zeros((q, 3, 14)), np.zeros((q, 3))
+    kernels.contact_rows(x, y, np.ones(q), deck, elems, vals, geo)
+    idx, rv = np.zeros((q, n), dtype=np.int64), np.zeros((q, 3, n))
+    nd = len(deck.dofs)
+    pidx, prv = np.zeros((q, nd), dtype=np.int64), np.zeros((q, 3, nd))
+    kernels.project_contacts(arrays, deck, elems, vals, geo, idx, rv, pidx, prv)
+    for i in range(q):
+        expected = np.zeros((3, n))
+        if elems[i] >= 0:
+            dofs = deck.node_dofs * elems[i] + deck.dofs
+            expected = vals[i][:, deck.dofs] @ arrays.phi[dofs]
+        scale = np.max(np.abs(expected)) or 1.0
+        assert np.max(np.abs(rv[i] - expected)) <= 1e-12 * scale, i  # round-off of a reordered sum
+    assert elems[-1] == -1 and not rv[-1].any()
+
+
+def test_the_capacitance_solve_matches_lapack():
+    """kernels.solve_small (Gaussian elimination, partial pivoting) against numpy.linalg.solve (LAPACK gesv)."""
+    rng = np.random.default_rng(11)
+    for q in (1, 2, 3, 8, 17):
+        for _ in range(20):
+            S = np.eye(q) + rng.normal(size=(q, q)) * rng.choice([0.1, 1.0, 10.0])
+            S[rng.integers(q), :] *= 1e-3 if q > 1 else 1.0  # a small row: pivoting matters
+            b = rng.normal(size=q)
+            expected = np.linalg.solve(S, b)
+            got = b.copy()
+            kernels.solve_small(S.copy(), got)
+            cond = np.linalg.cond(S)
+            assert np.max(np.abs(got - expected)) <= 1e-13 * cond * np.max(np.abs(expected)), (q, cond)

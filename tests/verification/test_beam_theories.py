@@ -202,8 +202,8 @@ def test_the_deck_row_is_the_elements_own_for_every_theory(theory):
     deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
                               float(section.y_s), float(bridge.length), np.array(DECK_POINT_DOFS, dtype=np.int64),
                               NODE_DOFS)
-    elems, vals = np.zeros(len(x), dtype=np.int64), np.zeros((len(x), 3, 14))
-    kernels.contact_rows(x, y, np.ones(len(x)), deck, elems, vals)  # speeds > 0: the +x rule at nodes
+    elems, vals, geo = np.zeros(len(x), dtype=np.int64), np.zeros((len(x), 3, 14)), np.zeros((len(x), 3))
+    kernels.contact_rows(x, y, np.ones(len(x)), deck, elems, vals, geo)  # speeds > 0: the +x rule at nodes
     dofs, values = bridge.deck_rows(x, y)
     h = 1e-4
     for i in range(len(x)):
