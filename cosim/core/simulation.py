@@ -41,6 +41,8 @@ BASES: tuple[str, ...] = ("direct", "modal")
 #: (5 ms) the solver thread waited that long for the GIL to leave its compiled loop while the traffic thread
 #: (SUMO, the adapter) ran Python: the two threads took turns instead of overlapping (benchmarks/results/).
 SWITCH_INTERVAL = 1e-4
+#: Steps advanced in one call at most when consecutive blocks of one fleet are joined (``join_blocks``).
+JOINED_STEPS = 2000
 #: Columns of :attr:`SimulationResult.vehicle_table`: the sample time, the vehicle's index, its fields.
 VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
@@ -265,6 +267,7 @@ def simulate(
     observers: Sequence[BlockObserver] = (),
     collect: bool = True,
     overlap: bool = True,
+    join_blocks: bool = True,
 ) -> SimulationResult:
     """Simulate ``duration`` seconds of traffic on the bridge.
 
@@ -286,6 +289,9 @@ def simulate(
             the current one in a worker thread: two cores work at once. The
             numbers are the same either way (the traffic does not depend on the
             bridge, and the blocks are advanced in order).
+        join_blocks: consecutive blocks of the same fleet (same vehicles and lateral offsets) are advanced
+            in one call of at most :data:`JOINED_STEPS` steps: each call costs the solver thread, the
+            observers and the log a fixed amount of Python. The numbers are the same to the bit.
     """
     _finite("", "duration", duration, 0.0)
     if duration < solver.dt:
@@ -338,21 +344,36 @@ def simulate(
     # the one before to the observers (the log) and asks the traffic for the one after. The worker takes them
     # in order, so the numbers are those of one block at a time.
     in_flight: collections.deque[tuple[Future[BlockReport], np.ndarray, np.ndarray]] = collections.deque()
+    group: list[tuple[TrafficBlock, np.ndarray]] = []  # traffic blocks of one fleet, not yet handed over
     switch_interval = sys.getswitchinterval()
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="cosim-solver") as solver_thread:
+
+        def hand_over() -> None:
+            blocks = [b for b, _ in group]
+            steps = group[0][1] if len(group) == 1 else np.concatenate([s for _, s in group])
+            group.clear()
+            block = blocks[0] if len(blocks) == 1 else TrafficBlock.join(blocks)
+            in_flight.append((solver_thread.submit(advance, block), steps, steps * solver.dt))
+            while len(in_flight) > (1 if overlap else 0):
+                finish(in_flight.popleft())
+
         try:
             if overlap:
                 sys.setswitchinterval(min(switch_interval, SWITCH_INTERVAL))
             done = 0
+            joined = 0
             while done < n_steps:
                 k = min(block_steps, n_steps - done)
                 steps = np.arange(done + 1, done + k + 1)
-                times = steps * solver.dt
-                block = traffic.block(times)  # while the worker advances the blocks before
-                in_flight.append((solver_thread.submit(advance, block), steps, times))
-                while len(in_flight) > (1 if overlap else 0):
-                    finish(in_flight.popleft())
+                block = traffic.block(steps * solver.dt)  # while the worker advances the blocks before
+                if group and not (join_blocks and joined + k <= JOINED_STEPS and block.same_fleet(group[-1][0])):
+                    hand_over()
+                    joined = 0
+                group.append((block, steps))
+                joined += k
                 done += k
+            if group:
+                hand_over()
             while in_flight:
                 finish(in_flight.popleft())
         finally:

@@ -82,6 +82,17 @@ class TrafficBlock:
     def from_frame(cls, frame: TrafficFrame) -> TrafficBlock:
         return cls(frame.ids, frame.models, frame.x[None, :], frame.v[None, :], frame.a[None, :], frame.y)
 
+    def same_fleet(self, other: TrafficBlock) -> bool:
+        """The same vehicles, models and lateral offsets (to the bit): the two blocks can be advanced as one."""
+        return self.ids == other.ids and self.models == other.models and np.array_equal(self.y, other.y)
+
+    @staticmethod
+    def join(blocks: list[TrafficBlock]) -> TrafficBlock:
+        """Consecutive blocks of one fleet (:meth:`same_fleet`) as one block of all their steps."""
+        first = blocks[0]
+        return TrafficBlock(first.ids, first.models, np.concatenate([b.x for b in blocks]),
+                            np.concatenate([b.v for b in blocks]), np.concatenate([b.a for b in blocks]), first.y)
+
 
 class TrafficSource(Protocol):
     """Anything that can say where the vehicles are at the times of a block of steps (s)."""

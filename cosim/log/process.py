@@ -33,7 +33,7 @@ import sys
 import threading
 import traceback
 import weakref
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
@@ -58,6 +58,17 @@ def writer_process_possible() -> bool:
     return (sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
             and threading.current_thread() is threading.main_thread()
             and not multiprocessing.current_process().daemon)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """The stop signals wait (blocked, then delivered) until a message is wholly in or out of a pipe: a signal
+    handler raising in the middle of one would leave the child reading the rest of a message never sent."""
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _first_line(exc: BaseException) -> str:
@@ -185,7 +196,8 @@ class LogProcess:
 
     def _reply(self) -> tuple[str, str | None]:
         try:
-            return self._replies.recv()
+            with _signals_held():
+                return self._replies.recv()
         except (EOFError, OSError):
             return "error", f"{self.path}: the log writer process ended unexpectedly " \
                             f"(exit status {self._process.exitcode})"
@@ -195,7 +207,8 @@ class LogProcess:
             raise LogError(f"{self.path}: the log is already closed")
         self.check()
         try:
-            self._commands.send(message)
+            with _signals_held():
+                self._commands.send(message)
         except OSError as exc:
             raise LogError(f"{self.path}: the log writer process is gone ({exc.strerror or exc})") from None
 
