@@ -102,7 +102,7 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
         return
     replies.send(("ready", None))
     logger: BlockLogger | None = None
-    traffic = TrafficLogger(rec)
+    sink: TrafficLogger | None = None  # SUMO frames, handed to the logger, which writes them between its pieces
     models: dict[str, Any] = {}
     error: str | None = None
     while True:
@@ -127,18 +127,20 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
         try:
             if op == "block":
                 _, times, keep, report, frames, new_models = message
+                assert logger is not None and sink is not None, "blocks before the block logger"
                 models.update(new_models)
                 for frame in frames:
-                    traffic.write_frame(frame, models)
-                if times is not None and logger is not None:
+                    sink(frame, models)
+                if times is not None:
                     logger.on_block(times, keep, report)
             elif op == "logger":
-                _, total_time, status_every, plan, first_column = message
+                _, total_time, status_every, plan, first_column, piece_steps = message
                 scene_writer = SceneWriter(rec, plan, first_column) if plan is not None else None
                 if scene_writer is not None:
                     scene_writer.start()
                 logger = BlockLogger(rec, names, total_time, status_every=status_every, threaded=False,
-                                     scene=scene_writer)
+                                     scene=scene_writer, piece_steps=piece_steps)
+                sink = logger.traffic_sink()
             else:
                 getattr(rec, op)(*message[1:])
         except BaseException as exc:  # noqa: BLE001 - reported to the run at its next block
@@ -275,13 +277,13 @@ class LogProcess:
 
     # ------------------------------------------------------ the block stream
     def block_logger(self, total_time: float, status_every: float, plan: Any = None,
-                     first_column: int = 0) -> _BlockStream:
+                     first_column: int = 0, piece_steps: int | None = None) -> _BlockStream:
         """The observer of :func:`cosim.core.simulation.simulate` that streams the blocks into this log.
 
         The child writes them with a :class:`cosim.log.writer.BlockLogger` (and draws ``plan``'s scene,
         :class:`cosim.log.scene.SceneWriter`, from the sensor columns from ``first_column`` on).
         """
-        self._send("logger", total_time, status_every, plan, first_column)
+        self._send("logger", total_time, status_every, plan, first_column, piece_steps)
         return _BlockStream(self)
 
 

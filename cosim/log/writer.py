@@ -14,6 +14,7 @@ log can be replayed. Topics and schemas: :mod:`cosim.log.schemas`.
 from __future__ import annotations
 
 import bisect
+import dataclasses
 import itertools
 import json
 import queue
@@ -283,6 +284,9 @@ class _PacedTraffic:
         return getattr(self.traffic, name)
 
 
+#: The per-step arrays of a :class:`cosim.core.coupling.BlockReport` (rows: steps).
+_PER_STEP = ("x", "v", "a", "on_deck", "contact_force", "body_displacement", "body_acceleration", "sensors",
+             "lifted")
 #: The :class:`cosim.core.coupling.BlockReport` array of a numeric vehicle field, where the names differ.
 _REPORT_ARRAYS = {"speed": "v", "acceleration": "a"}
 
@@ -300,14 +304,20 @@ class BlockLogger:
     time on a machine with a spare core; the queue holds a few blocks at most.
     Use as a context manager (or call :meth:`close`) so the thread drains.
 
+    ``piece_steps``: a block is written in pieces of at most this many steps, each topic's messages of a
+    piece together (the solver may hand over long blocks: one piece per topic would make chunks of each
+    topic span many seconds, and a window of the log would read more chunks).
+
     The first ``len(sensor_names)`` sensor columns of a block are logged; columns after them (the
     scene's, :mod:`cosim.log.scene`) go only to ``scene`` (an object with ``write_block(times, report)``),
     which draws the 3D scene in the same thread.
     """
 
     def __init__(self, recorder: LogRecorder, sensor_names: Iterable[str], total_time: float,
-                 status_every: float = 10.0, threaded: bool = True, scene: Any = None) -> None:
+                 status_every: float = 10.0, threaded: bool = True, scene: Any = None,
+                 piece_steps: int | None = None) -> None:
         self.rec = recorder
+        self.piece_steps = piece_steps
         self.names = list(sensor_names)
         self.scene = scene
         self.total_time = total_time
@@ -326,6 +336,7 @@ class BlockLogger:
         self._thread: threading.Thread | None = None
         self._traffic: TrafficLogger | None = None
         self._frames: list[tuple[Any, dict]] = []  # SUMO frames for the writer, handed over with the next block
+        self._ahead: list[tuple[Any, dict]] = []  # frames handed over, for the pieces of a later block
         if threaded:
             self._queue = queue.Queue(maxsize=4)
             self._thread = threading.Thread(target=self._drain, name="cosim-log-writer", daemon=True)
@@ -388,11 +399,11 @@ class BlockLogger:
         """Wait until every queued block (and every SUMO frame handed over) is written."""
         frames = self._frames[:]
         self._frames.clear()  # the same list: the traffic sink appends to it
-        if frames and self._traffic is not None:
+        if self._traffic is not None:  # with those handed over earlier for pieces that did not come
             if self._queue is not None and self._thread is not None:
                 self._queue.put((None, None, None, frames))
             elif self._error is None:
-                self._traffic.write_frames(frames)
+                self._write_block(None, None, None, frames)
         if self._thread is not None and self._queue is not None:
             self._closing = True
             if self._pace is not None:
@@ -416,11 +427,29 @@ class BlockLogger:
                 raise
 
     def _write_block(self, times, keep, report, frames: list[tuple[Any, dict]]) -> None:
-        rec = self.rec
-        if frames and self._traffic is not None:
-            self._traffic.write_frames(frames)
+        frames = self._ahead + frames
+        self._ahead = []
         if times is None:  # only frames (the last ones, at close)
+            if frames and self._traffic is not None:
+                self._traffic.write_frames(frames)
             return
+        piece = self.piece_steps or len(times)
+        for lo in range(0, len(times), piece):
+            hi = min(lo + piece, len(times))
+            if frames and self._traffic is not None:
+                # SUMO runs ahead of the bridge (by a block or more): each piece takes the frames up to the end
+                # of a piece after it, those beyond wait for the pieces they belong with.
+                limit = 2.0 * times[hi - 1] - times[lo] + (times[1] - times[0] if len(times) > 1 else 0.0)
+                upto = next((i for i, (f, _) in enumerate(frames) if f.t > limit + 1e-9), len(frames))
+                self._traffic.write_frames(frames[:upto])
+                frames = frames[upto:]
+            part = report if (lo, hi) == (0, len(times)) else dataclasses.replace(
+                report, **{name: getattr(report, name)[lo:hi] for name in _PER_STEP})
+            self._write_piece(times[lo:hi], keep[lo:hi], part)
+        self._ahead = frames
+
+    def _write_piece(self, times, keep, report) -> None:
+        rec = self.rec
         kept = np.flatnonzero(keep)
         if len(kept):
             t = times[kept]

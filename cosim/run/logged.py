@@ -58,6 +58,11 @@ FATIGUE_METADATA_NAME = "fatigue"
 LOGGED_MODES = 20
 #: How often a "running" status is logged, s of simulated time.
 STATUS_EVERY = 10.0
+#: The log is written in pieces of this much simulated time (at least LOG_PIECE_STEPS steps), s: the solver
+#: hands over blocks of up to JOINED_STEPS steps (cosim.core.simulation), and each topic's messages of a
+#: piece go into the log together.
+LOG_PIECE_SECONDS = 1.0
+LOG_PIECE_STEPS = 200
 #: Who encodes and writes the log: "process" (a child process, :mod:`cosim.log.process`), "thread" (a thread
 #: of the run's process), or "auto" (the process where that is possible, else the thread).
 LOG_WRITERS = ("auto", "process", "thread")
@@ -421,13 +426,14 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
         blocks: Any
+        piece = max(LOG_PIECE_STEPS, int(round(LOG_PIECE_SECONDS / solver.dt)))
         if isinstance(rec, LogProcess):
-            blocks = rec.block_logger(duration, STATUS_EVERY, plan, len(names))
+            blocks = rec.block_logger(duration, STATUS_EVERY, plan, len(names), piece)
         else:
             scene = SceneWriter(rec, plan, len(names)) if plan is not None else None
             if scene is not None:
                 scene.start()
-            blocks = BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene)
+            blocks = BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene, piece_steps=piece)
         with blocks as logger:
             if live_sumo:
                 traffic.frame_sink = logger.traffic_sink()
