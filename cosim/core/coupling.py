@@ -418,7 +418,7 @@ class CoupledSystem:
         self._sync(block)
         K, q = block.x.shape
         y = np.ascontiguousarray(block.y, dtype=float)
-        r, r_x = self.road.evaluate(np.broadcast_to(y, (K, q)), block.x)
+        r, r_x = self.road.evaluate(y, block.x)  # a path per vehicle (q,), broadcast over the steps (K, q)
         out = kernels.BlockOutputs(
             np.zeros((K, len(self.sensors))), np.zeros((K, q)), np.zeros((K, q)), np.zeros((K, q)),
             np.zeros((K, q), dtype=np.bool_), np.zeros((K, q), dtype=np.bool_), self._counters)

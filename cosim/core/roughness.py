@@ -82,7 +82,8 @@ class RoadProfile:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """Elevation (m) and slope of the wheel paths nearest to ``y`` (m) at positions ``x`` (m).
 
-        Linear interpolation of both; beyond the grid the end values are held.
+        ``y`` broadcasts against ``x`` (one offset per vehicle for positions (steps, vehicles)). Linear
+        interpolation of both; beyond the grid the end values are held.
         """
         path = self.path_index(y)
         s = (np.asarray(x, dtype=float) - self.x0) / self.dx
