@@ -31,6 +31,7 @@ import datetime
 import json
 import os
 import platform
+import statistics
 import subprocess
 import sys
 import time
@@ -159,22 +160,29 @@ def main(argv: list[str] | None = None) -> int:
     runs = ["sumo", *[r for r in RUNS if r != "sumo" and (not args.only or r in args.only)]]
     started = datetime.datetime.now()
     best: dict[str, dict] = {}
+    ratios: dict[str, list[float]] = {mode: [] for mode in runs}  # per repetition: against that repetition's SUMO
     for _ in range(args.reps):
+        sumo_now = None
         for mode in runs:
             r = run_one(mode, args.hours)
             print(mode, r, flush=True)
             if "error" in r or mode not in best or r["wall"] < best[mode].get("wall", float("inf")):
                 best[mode] = r
+            if "error" not in r:
+                if mode == "sumo":
+                    sumo_now = r["wall"]
+                elif sumo_now:
+                    ratios[mode].append(r["wall"] / sumo_now)
     sim = 3600.0 * args.hours
-    sumo = best["sumo"].get("wall")
     lines = [
         f"# A day of traffic: {args.hours:g} simulated hour(s) of the default run",
         "",
         f"{started:%Y-%m-%d %H:%M}, {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
         f"Python {platform.python_version()}; load average before: {os.getloadavg()[0]:.2f}.",
         "Paper bridge, medium SUMO demand (bundled), class A road, SUMO step 0.05 s, dt = 5 ms unless noted, "
-        "log at 100 Hz; each run in its own process; best of "
-        f"{args.reps}.",
+        "log at 100 Hz; each run in its own process. Wall times: the best of "
+        f"{args.reps}; ratios: each run against SUMO alone of the same repetition (run first in it), the "
+        "median over the repetitions and, in brackets, their range.",
         "",
         "Peak memory: the run's process, and its log writer process (a fork: pages it shares with the run "
         "count in both).",
@@ -187,7 +195,10 @@ def main(argv: list[str] | None = None) -> int:
         if "error" in r:
             lines.append(f"| {mode} | failed: {r['error']} | | | | | |")
             continue
-        ratio = f"{r['wall'] / sumo:.2f}" if sumo else "-"
+        ratio = "1.00" if mode == "sumo" else (
+            f"{statistics.median(ratios[mode]):.2f}" + (f" ({min(ratios[mode]):.2f}-{max(ratios[mode]):.2f})"
+                                                        if len(ratios[mode]) > 1 else "")
+            if ratios[mode] else "-")
         log_mb = f"{r['log_bytes'] / 1e6:.1f}" if r.get("log_bytes") else ""
         memory = f"{r['max_rss_mb']:.0f}" + (f" + {r['writer_rss_mb']:.0f}" if r.get("writer_rss_mb") else "")
         lines.append(f"| {mode} | {r['wall']:.1f} | {sim / r['wall']:.0f} | {ratio} | {memory} | "

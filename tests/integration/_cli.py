@@ -1,5 +1,5 @@
 """Shared by the command-line tests: run the ``cosim`` command line in this process (or, where a real
-process is the point, as ``python -m cosim``), and a small scenario."""
+process is the point, as ``python -m cosim``), a small scenario, and bundled scenarios with a few keys changed."""
 from __future__ import annotations
 
 import contextlib
@@ -10,8 +10,12 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import tomllib
+
 import cosim
 from cosim.cli import main
+from cosim.run.scenario import Scenario, load_scenario, parse_scenario
+from cosim.run.toml_writer import toml_dumps
 
 REPO = Path(cosim.__file__).resolve().parents[1]
 
@@ -110,3 +114,15 @@ seed = 7
 [solver]
 dt = 0.002
 """
+
+
+def bundled_scenario(name: str, *, end: float | None = None, dt: float | None = None) -> Scenario:
+    """The bundled scenario ``name`` with its SUMO run's ``[traffic] end`` (s) and ``[solver] dt`` (s) changed,
+    as a user's edited copy of it would be."""
+    base = load_scenario(name)
+    data = tomllib.loads(base.text)
+    if end is not None:
+        data["traffic"]["end"] = end
+    if dt is not None:
+        data["solver"]["dt"] = dt
+    return parse_scenario(toml_dumps(data), name, base_dir=base.base_dir)

@@ -6,15 +6,14 @@ import threading
 from pathlib import Path
 
 import pytest
-import tomllib
+from _cli import bundled_scenario
 from mcap.reader import make_reader
 
 from cosim.errors import ConfigError, LogError
 from cosim.log import TOPIC_SENSORS, TOPIC_STATUS, read_log
 from cosim.log.process import LogProcess, writer_process_possible
 from cosim.run.logged import run_logged
-from cosim.run.scenario import load_scenario, parse_scenario
-from cosim.run.toml_writer import toml_dumps
+from cosim.run.scenario import load_scenario
 
 STARTED = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
 #: SUMO's messages name its scratch folder (a new one per run): not compared.
@@ -36,11 +35,7 @@ def log_records(path: Path) -> tuple[list, list, list]:
 
 @pytest.mark.parametrize("name, end", [("paper-double-tee", None), ("paper-bridge-traffic", 20.0)])
 def test_the_process_writes_the_same_log_as_the_thread(tmp_path: Path, name: str, end: float | None) -> None:
-    base = load_scenario(name)
-    data = tomllib.loads(base.text)
-    if end is not None:  # SUMO: 20 s of traffic, the 3D scene and the SUMO frames included
-        data["traffic"]["end"] = end
-    scenario = parse_scenario(toml_dumps(data), name, base_dir=base.base_dir)
+    scenario = bundled_scenario(name, end=end)  # SUMO: 20 s of traffic, the 3D scene and SUMO's frames included
     bridge = scenario.build_bridge()
     logs = {}
     for writer in ("thread", "process"):
@@ -104,11 +99,7 @@ def test_joined_blocks_are_logged_in_pieces_exactly_as_block_by_block(tmp_path: 
     from cosim.log.writer import BlockLogger, LogRecorder
     from cosim.run.simulate import build_traffic
 
-    base = load_scenario("paper-bridge-traffic")
-    data = tomllib.loads(base.text)
-    data["traffic"]["end"] = 40.0
-    data["solver"]["dt"] = dt
-    scenario = parse_scenario(toml_dumps(data), "pieces", base_dir=base.base_dir)
+    scenario = bundled_scenario("paper-bridge-traffic", end=40.0, dt=dt)
     bridge = scenario.build_bridge()
     names = [s.name for s in scenario.sensors_core()]
     orders = []

@@ -9,16 +9,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import tomllib
+from _cli import bundled_scenario
 
 from cosim.core.bridge import PointLoad
 from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.vehicles import QuarterCar, TyreQuarterCar
 from cosim.errors import ConfigError, SumoError
-from cosim.run.scenario import load_scenario, parse_scenario
+from cosim.run.scenario import load_scenario
 from cosim.run.simulate import build_traffic
-from cosim.run.toml_writer import toml_dumps
 from cosim.sumo import (
     BridgeAxis,
     SumoTraffic,
@@ -414,11 +413,7 @@ def test_blocks_of_one_fleet_joined_give_the_same_numbers_to_the_bit(dt):
     """simulate(join_blocks=True) advances consecutive blocks with the same vehicles in one call; real SUMO
     traffic on the bundled bridge (vehicles entering and leaving, quiet gaps): the reference is the same run
     block by block."""
-    base = load_scenario("paper-bridge-traffic")
-    data = tomllib.loads(base.text)
-    data["traffic"]["end"] = 40.0
-    data["solver"]["dt"] = dt
-    scenario = parse_scenario(toml_dumps(data), "joined", base_dir=base.base_dir)
+    scenario = bundled_scenario("paper-bridge-traffic", end=40.0, dt=dt)
     bridge = scenario.build_bridge()
     runs, calls = [], []
     for join in (True, False):
