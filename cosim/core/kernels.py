@@ -234,6 +234,8 @@ def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
 def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
     """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values.
 
+    On a modal basis ``idx`` is every mode in order (:func:`advance_block` fills it once) and is not written.
+
     On a modal basis each mode's w, w_x, w_xx at the point come from its cubics
     on the element (:func:`modal_polynomials`). A complete modal engine
     (``basis.inverse`` given) also keeps the physical rows (``pidx``, ``prv``)
@@ -248,8 +250,6 @@ def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa
         m = basis.n
         pw, pt = basis.poly_w, basis.poly_t
         for i in range(q):
-            for j in range(m):
-                idx[i, j] = j
             e = elems[i]
             if e < 0:
                 for j in range(m):
@@ -544,6 +544,10 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     g1 = gamma * dt
     d, v, a, force = state.d, state.v, state.a, state.force
     idx = np.empty((q, nnz), dtype=np.int64)
+    if basis.kind == MODAL:  # every mode, in order, at every step
+        for i in range(q):
+            for j in range(nnz):
+                idx[i, j] = j
     rv = np.empty((q, 3, nnz))
     p = np.empty((q, nnz))
     contact = np.empty(q)
