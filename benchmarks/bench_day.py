@@ -37,6 +37,8 @@ import sys
 import time
 from pathlib import Path
 
+from _report import write_report  # benchmarks/ is on sys.path when a script runs
+
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
@@ -218,9 +220,7 @@ def main(argv: list[str] | None = None) -> int:
                       "with 8 quarter-cars (more physics: the vehicles' own dynamics)"]
     text = "\n".join(lines).rstrip() + "\n"
     print(text)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text, encoding="utf-8")
-    print(f"written: {args.out}")
+    write_report(text, args.out)
     return 0
 
 

@@ -22,6 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _report import write_report  # benchmarks/ is on sys.path when a script runs
+
 HERE = Path(__file__).resolve().parent
 
 CHILD = ("import sys\nfrom cosim.cli import main\nstatus = main(sys.argv[1:])\n"
@@ -85,9 +87,7 @@ def main(argv: list[str] | None = None) -> int:
     ]
     text = "\n".join(lines) + "\n"
     print(text)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text, encoding="utf-8")
-    print(f"written: {args.out}")
+    write_report(text, args.out)
     return 0
 
 

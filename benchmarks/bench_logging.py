@@ -43,6 +43,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
 
+from _report import write_report  # noqa: E402 - benchmarks/, on sys.path when a script runs
+
 from cosim.core.simulation import simulate  # noqa: E402
 from cosim.run.logged import run_logged  # noqa: E402
 from cosim.run.scenario import load_scenario, parse_scenario  # noqa: E402
@@ -159,7 +161,7 @@ def main() -> int:
     report = "\n".join(lines) + "\n"
     print(report)
     if args.out:
-        Path(args.out).write_text(report, encoding="utf-8")
+        write_report(report, args.out)
     return 0
 
 

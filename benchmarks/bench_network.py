@@ -32,6 +32,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from _report import write_report  # benchmarks/ is on sys.path when a script runs
+
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
@@ -230,9 +232,7 @@ def main() -> int:
         "alone on a shared machine). sumo+watch: cosim's adapter (subscriptions to the lanes around the deck), "
         "no beam. direct/modal: the co-simulation on the full FE model / 20 modes; +log: with the MCAP log (sensors, "
         "vehicles, events, every SUMO frame near the deck). The goal: co-simulation / SUMO alone <= 1.5.", ""])
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(table)
-    print(f"written: {args.out}")
+    write_report(table, args.out)
     return 0
 
 

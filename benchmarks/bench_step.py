@@ -60,6 +60,7 @@ import scipy.sparse.linalg as spla
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout without installing
 
 import numba  # noqa: E402
+from _report import write_report  # noqa: E402 - benchmarks/, on sys.path when a script runs
 
 from cosim.core import kernels  # noqa: E402
 from cosim.core.bases import make_basis  # noqa: E402
@@ -751,9 +752,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     text = markdown(report, machine, s, started, time.perf_counter() - t0)
     print()
     print(text)
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(text, encoding="utf-8")
-    print(f"written: {args.out}")
+    write_report(text, args.out)
     return 0
 
 

@@ -16,7 +16,8 @@ import json
 import os
 import subprocess
 import sys
-from pathlib import Path
+
+from _report import write_report  # benchmarks/ is on sys.path when a script runs
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
@@ -114,9 +115,7 @@ def main() -> int:
         "|---|---|---|---|---|---|---|", *rows, "",
         "Best of the repetitions; each run in its own process; modal = 30 modes; the log holds sensors, "
         "vehicles, events and every SUMO frame.", ""])
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    Path(args.out).write_text(table)
-    print(f"written: {args.out}")
+    write_report(table, args.out)
     return 0
 
 
