@@ -202,20 +202,15 @@ class CoupledSystem:
         every = np.array([s.every for s in self.sensors], dtype=np.int64)
         self._step0 = np.zeros(1, dtype=np.int64)  # shared by both engines' rows, set before each block
         # The engines that solve this basis: name -> (arrays, sensor rows in its coordinates).
-        arrays = basis.kernel_arrays()
-        if arrays.kind == kernels.MODAL:
-            arrays = arrays._replace(**dict(zip(("poly_w", "poly_t"), kernels.modal_polynomials(arrays.phi,
-                                                                                               self._deck))))
-        self._engines = {"basis": (arrays, kernels.SensorRows(idx, vals, order, every, self._step0))}
+        self._engines = {"basis": (kernels.with_modal_polynomials(basis.kernel_arrays(), self._deck),
+                                   kernels.SensorRows(idx, vals, order, every, self._step0))}
         self._complete = basis.complete if isinstance(basis, DirectBasis) else None
         if self._complete is not None and isinstance(basis, DirectBasis):
             dense = np.array([basis.reduce_rows(r.dofs[None, :], r.values[:1])[0] for r in rows],
                              dtype=float).reshape(len(rows), basis.n)
             modal_rows = dense @ self._complete.phi
             modal_idx = np.tile(np.arange(basis.n, dtype=np.int64), (len(rows), 1))
-            complete = basis.complete_kernel_arrays()
-            complete = complete._replace(**dict(zip(("poly_w", "poly_t"), kernels.modal_polynomials(complete.phi,
-                                                                                                  self._deck))))
+            complete = kernels.with_modal_polynomials(basis.complete_kernel_arrays(), self._deck)
             self._engines["complete-modal"] = (complete,
                                                kernels.SensorRows(modal_idx, modal_rows, order, every,
                                                                                   self._step0))

@@ -143,6 +143,14 @@ def modal_polynomials(phi: np.ndarray, deck: Any) -> tuple[np.ndarray, np.ndarra
     return np.ascontiguousarray(poly_w), np.ascontiguousarray(poly_t)
 
 
+def with_modal_polynomials(arrays: Any, deck: Any) -> Any:
+    """A modal basis' :data:`BasisArrays` with its :func:`modal_polynomials` on ``deck``; a direct one as it is."""
+    if arrays.kind != MODAL:
+        return arrays
+    poly_w, poly_t = modal_polynomials(arrays.phi, deck)
+    return arrays._replace(poly_w=poly_w, poly_t=poly_t)
+
+
 @compiled(inline=True)
 def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
     """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
@@ -234,10 +242,9 @@ def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
 def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa: ANN001, ANN201
     """Contact rows in basis coordinates: ``idx[i]`` the unknowns (-1: none), ``rv[i, order]`` the values.
 
-    On a modal basis ``idx`` is every mode in order (:func:`advance_block` fills it once) and is not written.
-
-    On a modal basis each mode's w, w_x, w_xx at the point come from its cubics
-    on the element (:func:`modal_polynomials`). A complete modal engine
+    On a modal basis ``idx`` is every mode in order (:func:`advance_block` fills it once) and is not written,
+    and each mode's w, w_x, w_xx at the point come from its cubics on the element
+    (:func:`modal_polynomials`). A complete modal engine
     (``basis.inverse`` given) also keeps the physical rows (``pidx``, ``prv``)
     for the capacitance matrix.
     """
@@ -374,15 +381,14 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
             pz[i] = s
         _capacitance(basis.inverse, idx, rv, p, groups, S)
         _mix_groups(groups, S, pz)
-        solve_small(S, pz)
-        sol = pz
+        solve_small(S, pz)  # pz <- S^-1 pz
         for j in range(us.shape[0]):
             us[j] = 0.0
         for i in range(q):
             for kk in range(nnz):
                 j = idx[i, kk]
                 if j >= 0:
-                    us[j] += rv[i, 0, kk] * sol[i]
+                    us[j] += rv[i, 0, kk] * pz[i]
         band_solve_into(basis.factor, us, corr)
         counters[2] += 1
         for j in range(z_b.shape[0]):
@@ -408,12 +414,11 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
                         s += p[i, j] * (a_inv[j] * rv[k, 0, j])
                     S[i, k] = s
         _mix_groups(groups, S, pz)
-        solve_small(S, pz)
-        sol = pz
+        solve_small(S, pz)  # pz <- S^-1 pz
         for j in range(m):
             c = 0.0
             for k in range(q):
-                c += rv[k, 0, j] * sol[k]
+                c += rv[k, 0, j] * pz[k]
             z_b[j] -= a_inv[j] * c
 
 

@@ -92,7 +92,6 @@ def _child(commands: Connection, replies: Connection, parent_ends: tuple[Connect
 
 
 def _serve(commands: Connection, replies: Connection, path: Path, names: list[str], scene: bool) -> None:
-    from .scene import SceneWriter
     from .writer import BlockLogger, LogRecorder, TrafficLogger
 
     try:
@@ -135,11 +134,8 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
                     logger.on_block(times, keep, report)
             elif op == "logger":
                 _, total_time, status_every, plan, first_column, piece_steps = message
-                scene_writer = SceneWriter(rec, plan, first_column) if plan is not None else None
-                if scene_writer is not None:
-                    scene_writer.start()
-                logger = BlockLogger(rec, names, total_time, status_every=status_every, threaded=False,
-                                     scene=scene_writer, piece_steps=piece_steps)
+                logger = BlockLogger.for_run(rec, names, total_time, status_every=status_every, plan=plan,
+                                             first_column=first_column, piece_steps=piece_steps, threaded=False)
                 sink = logger.traffic_sink()
             else:
                 getattr(rec, op)(*message[1:])

@@ -342,6 +342,19 @@ class BlockLogger:
             self._thread = threading.Thread(target=self._drain, name="cosim-log-writer", daemon=True)
             self._thread.start()
 
+    @classmethod
+    def for_run(cls, recorder: LogRecorder, sensor_names: Iterable[str], total_time: float, *, status_every: float,
+                plan: Any, first_column: int, piece_steps: int | None, threaded: bool) -> BlockLogger:
+        """The logger of a run: with ``plan``'s 3D scene (a :class:`cosim.log.scene.ScenePlan`, or None), started
+        here (its static part and the deck at rest), drawn from the sensor columns from ``first_column`` on."""
+        from .scene import SceneWriter  # the scene's drawing needs scipy: only runs that draw one load it
+
+        scene = SceneWriter(recorder, plan, first_column) if plan is not None else None
+        if scene is not None:
+            scene.start()
+        return cls(recorder, sensor_names, total_time, status_every=status_every, threaded=threaded, scene=scene,
+                   piece_steps=piece_steps)
+
     def on_block(self, times, keep, report) -> None:
         if self._error is not None:
             raise LogError(f"{self.rec.path}: writing the log failed: {self._error}")

@@ -34,7 +34,7 @@ from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
 from cosim.log.process import LogProcess, writer_process_possible
-from cosim.log.scene import ScenePlan, SceneWriter, plan_scene, scene_sensors, scene_wanted
+from cosim.log.scene import ScenePlan, plan_scene, scene_sensors, scene_wanted
 from cosim.log.schemas import (
     LAYOUT_ATTACHMENT,
     METADATA_NAME,
@@ -430,10 +430,8 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
         if isinstance(rec, LogProcess):
             blocks = rec.block_logger(duration, STATUS_EVERY, plan, len(names), piece)
         else:
-            scene = SceneWriter(rec, plan, len(names)) if plan is not None else None
-            if scene is not None:
-                scene.start()
-            blocks = BlockLogger(rec, names, duration, status_every=STATUS_EVERY, scene=scene, piece_steps=piece)
+            blocks = BlockLogger.for_run(rec, names, duration, status_every=STATUS_EVERY, plan=plan,
+                                         first_column=len(names), piece_steps=piece, threaded=True)
         with blocks as logger:
             if live_sumo:
                 traffic.frame_sink = logger.traffic_sink()
