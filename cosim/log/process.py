@@ -40,7 +40,7 @@ from typing import Any
 
 from cosim.errors import LogError
 
-__all__ = ["ORPHANED", "LogProcess", "writer_process_possible"]
+__all__ = ["ORPHANED", "LogProcess", "pack_frames", "unpack_frames", "writer_process_possible"]
 
 #: The final status message of a log whose run's process died before it closed the log.
 ORPHANED = "the run's process ended without finishing its log (killed, e.g. SIGKILL or out of memory)"
@@ -51,6 +51,35 @@ PIPE_BYTES = 1 << 20
 CLOSE_TIMEOUT = 120.0
 _F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)
 _STOPS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+
+
+def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
+    """SUMO frames as a few flat columns for the pipe: pickling each frame's four small arrays cost the run's
+    thread more than all its blocks (0.19 s of 0.28 s in 10 min of the default run)."""
+    import numpy as np
+
+    if not frames:
+        return ()
+    return ([f.t for f in frames], [len(f.ids) for f in frames],
+            tuple(i for f in frames for i in f.ids), tuple(t for f in frames for t in f.types),
+            *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")))
+
+
+def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
+    """The frames of :func:`pack_frames`, equal to those packed (the same numbers, bit for bit)."""
+    from cosim.core.traffic import Frame
+
+    if not packed:
+        return []
+    times, counts, ids, types, x, y, v, a = packed
+    out = []
+    start = 0
+    for t, n in zip(times, counts):
+        end = start + n
+        out.append(Frame(t=t, ids=ids[start:end], x=x[start:end], y=y[start:end], v=v[start:end], a=a[start:end],
+                         types=types[start:end]))
+        start = end
+    return out
 
 
 def writer_process_possible() -> bool:
@@ -128,7 +157,7 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
                 _, times, keep, report, frames, new_models = message
                 assert logger is not None and sink is not None, "blocks before the block logger"
                 models.update(new_models)
-                for frame in frames:
+                for frame in unpack_frames(frames):
                     sink(frame, models)
                 if times is not None:
                     logger.on_block(times, keep, report)
@@ -298,7 +327,7 @@ class _BlockStream:
     def _hand_over(self, times, keep, report) -> None:  # noqa: ANN001
         frames, self._frames = self._frames, []
         models, self._new_models = self._new_models, {}
-        self.log._send("block", times, keep, report, frames, models)
+        self.log._send("block", times, keep, report, pack_frames(frames), models)
 
     def traffic_sink(self) -> _FrameSink:
         """A frame sink for a live traffic source (SUMO): its frames go to the child with the next block."""

@@ -5,13 +5,15 @@ import datetime
 import threading
 from pathlib import Path
 
+import numpy as np
 import pytest
 from _cli import bundled_scenario
 from mcap.reader import make_reader
 
+from cosim.core.traffic import Frame
 from cosim.errors import ConfigError, LogError
 from cosim.log import TOPIC_SENSORS, TOPIC_STATUS, read_log
-from cosim.log.process import LogProcess, writer_process_possible
+from cosim.log.process import LogProcess, pack_frames, unpack_frames, writer_process_possible
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
 
@@ -117,3 +119,18 @@ def test_joined_blocks_are_logged_in_pieces_exactly_as_block_by_block(tmp_path: 
     joined, separate = orders
     assert sum(topic == "/cosim/traffic" for topic, _, _ in separate) > 100  # SUMO's frames are among them
     assert joined == separate
+
+
+def test_frames_packed_for_the_pipe_come_back_equal_bit_for_bit() -> None:
+    rng = np.random.default_rng(7)
+    frames = []
+    for k, n in enumerate((0, 2, 0, 3, 1)):  # empty frames too: they carry time for the log's pieces
+        ids = tuple(f"v{k}.{i}" for i in range(n))
+        frames.append(Frame(0.05 * (k + 1), ids, *(rng.normal(size=n) for _ in range(4)), tuple("car" for _ in ids)))
+    back = unpack_frames(pack_frames(frames))
+    assert len(back) == len(frames)
+    for got, sent in zip(back, frames):
+        assert (got.t, got.ids, got.types) == (sent.t, sent.ids, sent.types)
+        for column in ("x", "y", "v", "a"):
+            assert getattr(got, column).tobytes() == getattr(sent, column).tobytes()  # the same doubles
+    assert unpack_frames(pack_frames([])) == []
