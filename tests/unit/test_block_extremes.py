@@ -1,0 +1,28 @@
+"""The compiled running extremes of a run (cosim.core.simulation.block_extremes) against numpy's reductions."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cosim.core.simulation import block_extremes
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_block_extremes_equal_numpys_masked_reductions(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    steps, n_sensors, q = rng.integers(1, 300), rng.integers(0, 12), rng.integers(0, 9)
+    sensors = rng.normal(size=(steps, n_sensors))
+    sensors[rng.random(sensors.shape) < 0.3] = np.nan  # sensors read only at some steps
+    on_deck = rng.random((steps, q)) < 0.6
+    force = rng.normal(1e4, 3e3, size=(steps, q))
+    col_owner = np.sort(rng.integers(0, max(q, 1), size=q))  # axles of one vehicle are consecutive columns
+    s_min, s_max = np.zeros(n_sensors), np.zeros(n_sensors)
+    f_min, f_max = np.full(q, np.inf), np.full(q, -np.inf)
+    most = block_extremes(sensors, s_min, s_max, on_deck, force, col_owner, f_min, f_max)
+    # Reference: numpy's NaN-skipping and masked reductions (the code this kernel replaced).
+    assert np.array_equal(s_min, np.fmin(0.0, np.fmin.reduce(sensors, axis=0, initial=np.inf)))
+    assert np.array_equal(s_max, np.fmax(0.0, np.fmax.reduce(sensors, axis=0, initial=-np.inf)))
+    assert np.array_equal(f_min, np.where(on_deck, force, np.inf).min(axis=0, initial=np.inf))
+    assert np.array_equal(f_max, np.where(on_deck, force, -np.inf).max(axis=0, initial=-np.inf))
+    vehicles_on = [len({int(col_owner[j]) for j in np.flatnonzero(row)}) for row in on_deck]
+    assert most == (max(vehicles_on) if q else 0)
