@@ -350,12 +350,18 @@ class FrameTraffic:
         k_of = np.maximum(k_of, self._first)
         k_lo, k_hi = int(k_of.min()), int(k_of.max())
         frames = [self._frame_at(k) for k in range(k_lo, k_hi + 2)]  # frames k_lo .. k_hi + 1
-        # One column per vehicle seen in any frame of the block; rows = frames.
+        # One column per vehicle seen in any frame of the block; rows = frames. Filled in one scatter per
+        # column, not one per frame: a block holds tens of frames of a few vehicles each.
         index: dict[str, int] = {}
-        for f in frames:
-            for vid in f.ids:
-                if vid not in index:
-                    index[vid] = len(index)
+        type_of: dict[int, str] = {}
+        frame_of: list[int] = []
+        column_of: list[int] = []
+        for r, f in enumerate(frames):
+            for vid, typ in zip(f.ids, f.types):
+                c = index.setdefault(vid, len(index))
+                type_of[c] = typ
+                frame_of.append(r)
+                column_of.append(c)
         q_all = len(index)
         n_f = len(frames)
         FX = np.zeros((n_f, q_all))
@@ -363,15 +369,10 @@ class FrameTraffic:
         FA = np.zeros((n_f, q_all))
         FY = np.zeros((n_f, q_all))
         seen = np.zeros((n_f, q_all), dtype=bool)
-        type_of: dict[int, str] = {}
-        for r, f in enumerate(frames):
-            if not f.ids:
-                continue
-            cols = np.fromiter((index[v] for v in f.ids), dtype=np.int64, count=len(f.ids))
-            FX[r, cols], FV[r, cols], FA[r, cols], FY[r, cols] = f.x, f.v, f.a, f.y
-            seen[r, cols] = True
-            for c, typ in zip(cols.tolist(), f.types):
-                type_of[c] = typ
+        if frame_of:
+            at = (np.array(frame_of), np.array(column_of))
+            FX[at], FV[at], FA[at], FY[at] = (np.concatenate([getattr(f, c) for f in frames]) for c in "xvay")
+            seen[at] = True
         # Motion over each interval (row r: from frame r to frame r + 1), for vehicles in frame r + 1.
         step = self.step
         v1, a1, x1 = FV[1:], FA[1:], FX[1:]

@@ -81,3 +81,22 @@ def test_user_profile_from_csv(tmp_path):
         profile_from_csv(bad)
     with pytest.raises(ConfigError, match="cannot read"):
         profile_from_csv(tmp_path / "missing.csv")
+
+
+def test_evaluate_is_numpys_linear_interpolation_bit_for_bit():
+    prof = iso8608_profile("C", 3, -15.0, 55.0, path_y=(-1.75, 0.0, 1.75), dx=0.05)
+    rng = np.random.default_rng(11)
+    x = rng.uniform(-30.0, 70.0, size=(200, 4))  # beyond both ends too: the end values are held
+    x[0, 0] = -1e6  # an absent vehicle
+    y = np.array([-1.7, 0.1, 1.9, 0.0])
+    r, r_x = prof.evaluate(y, x)
+    # Reference: the same interpolation written with numpy's array operations.
+    path = prof.path_index(y)
+    nx = prof.r.shape[1]
+    s = np.clip((x - prof.x0) / prof.dx, 0.0, nx - 1.0)
+    i = np.minimum(s.astype(np.int64), nx - 2)
+    f = s - i
+    assert np.array_equal(r, (1 - f) * prof.r[path, i] + f * prof.r[path, i + 1])
+    assert np.array_equal(r_x, (1 - f) * prof.r_x[path, i] + f * prof.r_x[path, i + 1])
+    one, one_x = prof.evaluate(y[2:3], x[5, 2:3])  # one point: the same numbers as in the block
+    assert one.shape == (1,) and one[0] == r[5, 2] and one_x[0] == r_x[5, 2]
