@@ -278,8 +278,10 @@ def _json(value: Any) -> bytes:
 
 
 def _template(value: Any) -> bytes:
-    """``value`` as JSON, for a bytes %-template whose ``"%s"`` strings stand for numbers."""
-    return _json(value).replace(b"%", b"%%").replace(b'"%%s"', b"%s")
+    """``value`` as JSON, for a bytes %-template whose ``"%s"`` strings stand for encoded JSON (numbers from
+    :func:`_tokens`, strings) and ``"%r"`` for Python numbers (a rounded float's or an int's repr is the JSON
+    orjson writes for it)."""
+    return _json(value).replace(b"%", b"%%").replace(b'"%%s"', b"%s").replace(b'"%%r"', b"%r")
 
 
 def _vec(x: float, y: float, z: float) -> dict[str, float]:
@@ -298,6 +300,12 @@ def _entity(entity_id: str, t: float, **primitives: Any) -> dict[str, Any]:
 
 
 _Z = "%s"  # a number filled in at every scene
+_R = "%r"  # a Python number filled in at every scene
+
+
+def _c(value: float) -> float:
+    """A coordinate rounded to the drawing's centimetre (no "-0.0"), as :func:`_vec` writes it."""
+    return round(float(value), _DECIMALS) + 0.0
 
 
 class SceneWriter:
@@ -327,6 +335,7 @@ class SceneWriter:
         self._surface = self._deck_template()
         self._paths_template = self._path_template()
         self._sensors_template = self._sensor_template()
+        self._vehicle_templates: dict[tuple[bool, int, tuple[int, ...]], bytes] = {}
 
     # ------------------------------------------------------------- geometry
     def spline_matrix(self, x: np.ndarray) -> np.ndarray:
@@ -484,7 +493,7 @@ class SceneWriter:
             if plan.sensors:
                 parts.append(self._stamp(self._sensors_template % rows_marks[i], stamp))
             if vehicles:
-                parts.extend(_json(v) for v in self._vehicles(t, report, k, groups, heavy, x[i], near[i], z[i]))
+                parts.extend(self._vehicles(t, report, k, groups, heavy, x[i], near[i], z[i]))
             head = b'{"deletions":[{' + stamp + b',"type":1,"id":""}],"entities":['
             datas.append(head + b",".join(parts) + b"]}")
         self.rec.write_encoded(TOPIC_SCENE, times, datas)
@@ -493,44 +502,68 @@ class SceneWriter:
     def _stamp(entity: bytes, stamp: bytes) -> bytes:
         return entity.replace(b'"timestamp":{"sec":0,"nsec":0}', stamp, 1)
 
+    def _vehicle_template(self, big: bool, axles: int, arrows: tuple[int, ...]) -> bytes:
+        """A vehicle's entity with its numbers left open (``arrows``: per axle 0 none, 1 push, -1 pull), made
+        once per shape: building and encoding the nested dicts at every scene was most of the scene's cost."""
+        key = (big, axles, arrows)
+        template = self._vehicle_templates.get(key)
+        if template is None:
+            width, height = (2.5, 3.0) if big else (1.8, 1.4)
+            wheel = 0.9 if big else 0.65
+            point = {"x": _R, "y": _R, "z": _R}
+            box = {"pose": {"position": point, "orientation": _IDENTITY},
+                   "size": {"x": _R, "y": _c(width), "z": _c(height)}, "color": _TRUCK if big else _CAR}
+            cylinders = [{"pose": {"position": point, "orientation": _AXLE_ALONG_Y},
+                          "size": _vec(wheel, wheel, width + 0.2), "color": _WHEEL} for _ in range(axles)]
+            drawn = [{"pose": {"position": point, "orientation": _ARROW_DOWN if sign > 0 else _ARROW_UP},
+                      "shaft_length": _R, "shaft_diameter": 0.2, "head_length": _R, "head_diameter": 0.5,
+                      "color": _PUSH if sign > 0 else _PULL} for sign in arrows if sign]
+            entity = {"timestamp": {"sec": _R, "nsec": _R}, "frame_id": SCENE_FRAME, "id": _Z,
+                      "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": False, "cubes": [box],
+                      "cylinders": cylinders, "arrows": drawn}
+            template = self._vehicle_templates[key] = _template(entity)
+        return template
+
     def _vehicles(self, t: float, report: Any, k: int, groups: dict[str, list[int]], heavy: dict[str, bool],
-                  x_all: np.ndarray, near: np.ndarray, z_all: np.ndarray) -> list[dict[str, Any]]:
+                  x_all: np.ndarray, near: np.ndarray, z_all: np.ndarray) -> list[bytes]:
         """A box over each vehicle's axles, its wheels (axles) and its contact forces as arrows, at step ``k`` of
-        the block. ``groups``: each vehicle's contact columns; ``x_all``, ``z_all``: the contact points' x and
-        drawn deck level, m; ``near``: on or near the deck."""
+        the block, as encoded entities. ``groups``: each vehicle's contact columns; ``x_all``, ``z_all``: the
+        contact points' x and drawn deck level, m; ``near``: on or near the deck."""
         plan = self.plan
-        y_all = np.asarray(report.y, dtype=float)
+        y_all = report.y
+        forces = report.contact_force[k]
+        on_deck = report.on_deck[k]
+        ns = int(round(t * 1e9))
+        sec, nsec = ns // 1_000_000_000, ns % 1_000_000_000
         out = []
         for owner, cols in groups.items():
-            if not near[cols].any():
-                continue
             cols = [j for j in cols if near[j]]
-            xs = x_all[cols]
+            if not cols:
+                continue
+            xs = [float(x_all[j]) for j in cols]
+            zs = [float(z_all[j]) for j in cols]
             big = heavy[owner]
             width, height = (2.5, 3.0) if big else (1.8, 1.4)
             overhang = 1.5 if len(cols) > 1 else (5.0 if big else 2.25)
-            front, back = float(xs.max()) + overhang, float(xs.min()) - overhang
+            front, back = max(xs) + overhang, min(xs) - overhang
             y = sum(float(y_all[j]) for j in cols) / len(cols)
-            z0 = sum(float(z_all[j]) for j in cols) / len(cols)
+            z0 = sum(zs) / len(cols)
             wheel = 0.9 if big else 0.65
-            box = {"pose": {"position": _vec((front + back) / 2, y, z0 + wheel * 0.6 + height / 2),
-                            "orientation": _IDENTITY},
-                   "size": _vec(front - back, width, height), "color": _TRUCK if big else _CAR}
-            axles = [{"pose": {"position": _vec(x_all[j], y, z_all[j] + wheel / 2), "orientation": _AXLE_ALONG_Y},
-                      "size": _vec(wheel, wheel, width + 0.2), "color": _WHEEL} for j in cols]
+            numbers: list[Any] = [sec, nsec, orjson.dumps(f"vehicle {owner}"),
+                                  _c((front + back) / 2), _c(y), _c(z0 + wheel * 0.6 + height / 2), _c(front - back)]
+            for x, z in zip(xs, zs):
+                numbers += (_c(x), _c(y), _c(z + wheel / 2))
             arrows = []
-            for j in cols:
-                force = float(report.contact_force[k, j])
+            for j, x, z in zip(cols, xs, zs):
+                force = float(forces[j])
                 length = min(abs(force) / plan.newton_per_m, 4.0 * ARROW_LENGTH)
-                if not report.on_deck[k, j] or length < 0.05:
+                if not on_deck[j] or length < 0.05:
+                    arrows.append(0)
                     continue
+                arrows.append(1 if force > 0 else -1)
                 head = min(0.5, 0.5 * length)
-                z_tail = float(z_all[j]) + (length if force > 0 else 0.0)
                 # Beside the body (on its right), where the box does not hide it, down to the deck.
-                arrows.append({"pose": {"position": _vec(x_all[j], y - width / 2 - 0.4, z_tail),
-                                        "orientation": _ARROW_DOWN if force > 0 else _ARROW_UP},
-                               "shaft_length": round(length - head, _DECIMALS), "shaft_diameter": 0.2,
-                               "head_length": round(head, _DECIMALS), "head_diameter": 0.5,
-                               "color": _PUSH if force > 0 else _PULL})
-            out.append(_entity(f"vehicle {owner}", t, cubes=[box], cylinders=axles, arrows=arrows))
+                numbers += (_c(x), _c(y - width / 2 - 0.4), _c(z + (length if force > 0 else 0.0)),
+                            round(length - head, _DECIMALS), round(head, _DECIMALS))
+            out.append(self._vehicle_template(big, len(cols), tuple(arrows)) % tuple(numbers))
         return out

@@ -592,19 +592,36 @@ class TrafficLogger:
             self.write_frame(frame, models)
 
     def write_frames(self, frames: list[tuple[Any, dict]]) -> None:
-        """Write frames handed over by :meth:`__call__`, in order."""
+        """Write frames handed over by :meth:`__call__`, in order: encoded together and added in one bulk
+        write (per-message writes were a sixth of the log writer's time), a new vehicle type's message
+        still before the first frame that has it."""
+        times: list[float] = []
+        datas: list[bytes] = []
         for frame, models in frames:
-            self.write_frame(frame, models)
+            if any(typ not in self._types for typ in frame.types):
+                self.rec.write_encoded(TOPIC_TRAFFIC, times, datas)
+                times, datas = [], []
+                self._write_types(frame, models)
+            if frame.ids:
+                times.append(frame.t)
+                datas.append(self._encode(frame))
+        self.rec.write_encoded(TOPIC_TRAFFIC, times, datas)
 
     def write_frame(self, frame, models: dict) -> None:
         """Write one frame (and the vehicle types it brings first)."""
+        self._write_types(frame, models)
+        if frame.ids:
+            self.rec.write_encoded(TOPIC_TRAFFIC, [frame.t], [self._encode(frame)])
+
+    def _write_types(self, frame, models: dict) -> None:
         for typ in frame.types:
             if typ not in self._types:
                 self._types.add(typ)
                 self.rec.write(TOPIC_VEHICLE_TYPES, frame.t, {"t": frame.t, "type": typ,
                                                               "model": model_to_dict(models[typ])})
-        if not frame.ids:
-            return
-        self.rec.write(TOPIC_TRAFFIC, frame.t, {
+
+    @staticmethod
+    def _encode(frame) -> bytes:
+        return orjson.dumps({
             "t": frame.t, "ids": list(frame.ids), "x": frame.x.tolist(), "y": frame.y.tolist(),
             "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
