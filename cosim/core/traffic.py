@@ -18,6 +18,7 @@ import numpy.typing as npt
 
 from cosim.errors import ConfigError
 
+from .jit import compiled
 from .vehicles import MODELS, VehicleModel
 
 AXLE_SEPARATOR = "#"
@@ -373,29 +374,16 @@ class FrameTraffic:
             at = (np.array(frame_of), np.array(column_of))
             FX[at], FV[at], FA[at], FY[at] = (np.concatenate([getattr(f, c) for f in frames]) for c in "xvay")
             seen[at] = True
-        # Motion over each interval (row r: from frame r to frame r + 1), for vehicles in frame r + 1.
-        step = self.step
-        v1, a1, x1 = FV[1:], FA[1:], FX[1:]
-        had = seen[:-1]
-        v0 = np.where(had, FV[:-1], v1 - a1 * step)
-        x0 = np.where(had, FX[:-1], x1 - step * 0.5 * (v0 + v1))
-        acc = (v1 - v0) / step
-        gap = x1 - (x0 + step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
         r_of = k_of - k_lo
-        tau = (times - np.array([frames[r].t for r in range(n_f)])[r_of])[:, None]
-        X = x0[r_of] + v0[r_of] * tau + 0.5 * acc[r_of] * tau**2 + gap[r_of] * tau / step
-        V = v0[r_of] + acc[r_of] * tau + gap[r_of] / step
-        A = acc[r_of]
-        present = seen[1:][r_of]
+        frame_t = np.array([f.t for f in frames])
+        X, V, A, present = _ballistic_between_frames(FX, FV, FA, seen, frame_t, times, r_of, self.step)
         on = present & on_deck(X, self.length)
         ids = list(index)
         wanted = on.any(axis=0)
         if any(getattr(self.models[type_of[c]], "contacts", 1) > 1 for c in np.flatnonzero(wanted).tolist()):
             wanted = self._whole_vehicles(ids, wanted)
         keep = np.flatnonzero(wanted)
-        X = np.where(present, X, -1e6)[:, keep]  # absent: far before the deck
-        V = np.where(present, V, 0.0)[:, keep]
-        A = np.where(present, A, 0.0)[:, keep]
+        X, V, A = X[:, keep], V[:, keep], A[:, keep]
         # One lateral offset per block: where the vehicle was at its last frame in the block.
         rows = present[:, keep]
         last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
@@ -412,3 +400,39 @@ class FrameTraffic:
         owners = [vehicle_of(i) for i in ids]
         chosen = {o for o, w in zip(owners, wanted.tolist()) if w}
         return np.array([o in chosen for o in owners], dtype=bool)
+
+
+@compiled(nogil=True)
+def _ballistic_between_frames(FX: np.ndarray, FV: np.ndarray, FA: np.ndarray, seen: np.ndarray, frame_t: np.ndarray,
+                              times: np.ndarray, r_of: np.ndarray, step: float
+                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Position, speed and acceleration (steps, vehicles) at ``times`` from the frames (rows; step ``r_of[k]``
+    lies between frames r and r + 1), as :class:`FrameTraffic` describes; a vehicle absent from frame r + 1 is
+    far before the deck (x = -1e6, at rest) and not ``present``. Compiled: as numpy array operations these
+    were three dozen passes over small arrays per block, in the thread that runs SUMO. The expressions keep
+    numpy's order of operations, so the numbers are the same to the bit."""
+    steps, q = len(times), FX.shape[1]
+    X = np.empty((steps, q))
+    V = np.empty((steps, q))
+    A = np.empty((steps, q))
+    present = np.empty((steps, q), dtype=np.bool_)
+    for k in range(steps):
+        r = r_of[k]
+        tau = times[k] - frame_t[r]
+        for j in range(q):
+            if not seen[r + 1, j]:
+                X[k, j], V[k, j], A[k, j], present[k, j] = -1e6, 0.0, 0.0, False
+                continue
+            v1, a1, x1 = FV[r + 1, j], FA[r + 1, j], FX[r + 1, j]
+            if seen[r, j]:
+                v0, x0 = FV[r, j], FX[r, j]
+            else:  # first seen at frame r + 1: traced back along the same motion
+                v0 = v1 - a1 * step
+                x0 = x1 - step * 0.5 * (v0 + v1)
+            acc = (v1 - v0) / step
+            gap = x1 - (x0 + step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
+            X[k, j] = x0 + v0 * tau + 0.5 * acc * (tau * tau) + gap * tau / step
+            V[k, j] = v0 + acc * tau + gap / step
+            A[k, j] = acc
+            present[k, j] = True
+    return X, V, A, present

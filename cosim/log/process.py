@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
+import itertools
 import multiprocessing
 import signal
 import sys
@@ -61,7 +62,8 @@ def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
     if not frames:
         return ()
     return ([f.t for f in frames], [len(f.ids) for f in frames],
-            tuple(i for f in frames for i in f.ids), tuple(t for f in frames for t in f.types),
+            tuple(itertools.chain.from_iterable(f.ids for f in frames)),
+            tuple(itertools.chain.from_iterable(f.types for f in frames)),
             *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")))
 
 
