@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
+from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, axles_on_axis
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
@@ -147,6 +147,7 @@ class SumoTraffic:
         if not end > begin:
             raise ConfigError(f"traffic `end` ({end} s) must be after `begin` ({begin} s)")
         self.axis, self.step, self.begin, self.end = axis, float(step), float(begin), float(end)
+        self._deck_length = float(axis.length)
         self.seed = seed
         self.deck_y = (float(deck_y[0]), float(deck_y[1])) if deck_y is not None else (-half_width, half_width)
         self.half_width = max(abs(self.deck_y[0]), abs(self.deck_y[1]))
@@ -223,6 +224,7 @@ class SumoTraffic:
             self.close()
             raise
         self._unit = self.axis.unit()
+        self._origin = np.array(self.axis.start, dtype=float)
         self.frames = FrameTraffic(self.step, self.axis.length, self.models)
         return self
 
@@ -333,6 +335,11 @@ class SumoTraffic:
                 self._subscribed_lanes.add(lane)
         self.lanes = tuple(self._subscribed_lanes)
 
+    @property
+    def _x_range(self) -> tuple[float, float]:
+        """Contact points farther along the axis than this from the deck are not followed, m."""
+        return (-self.reach, self._deck_length + self.reach)
+
     def _extend_reach(self) -> None:
         """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
         longest = max((t.length for t in self.types.values()), default=0.0)
@@ -399,6 +406,7 @@ class SumoTraffic:
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(ids, num)               # drop only keeps a far vehicle subscribed a while longer
         if all(len(self._axles[typ]) == 1 for typ in types):
+            owner = np.arange(len(rows))
             back = 0.5 * num[:, 5]
         else:
             owner = np.array([i for i, typ in enumerate(types) for _ in self._axles[typ]], dtype=np.int64)
@@ -408,28 +416,14 @@ class SumoTraffic:
                    for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
             types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
                      for typ in types for k in range(len(self._axles[typ]))]
-            num = num[owner]
-        e, n = self._unit
-        heading = np.radians(num[:, 2])
-        hx, hy = np.sin(heading), np.cos(heading)  # SUMO angle: 0 = north, clockwise
-        dx = num[:, 0] - back * hx - self.axis.start[0]
-        dy = num[:, 1] - back * hy - self.axis.start[1]
-        x, y = dx * e[0] + dy * e[1], dx * n[0] + dy * n[1]
-        along = hx * e[0] + hy * e[1]
-        # Axles on the deck's width and within the watched reach along it (a vehicle on a long lane
-        # after the deck is dropped once far from it).
-        keep = (y >= self.deck_y[0]) & (y <= self.deck_y[1]) & (x >= -self.reach) & (x <= self.axis.length
-                                                                                     + self.reach)
-        spd, acc = num[:, 3], num[:, 4]
-        if not keep.all() and len(keep) != len(rows):  # a vehicle's axles stay together (one body, several axles)
-            whole = np.zeros(len(rows), dtype=bool)
-            np.logical_or.at(whole, owner, keep)
-            keep = whole[owner]
+        # Axles on the deck's width and within the watched reach along it (a vehicle on a long lane after the
+        # deck is dropped once far from it); a vehicle's axles stay together (one body, several axles).
+        x, y, v, a, keep = axles_on_axis(num, back, owner, self._origin, *self._unit, self.deck_y, self._x_range)
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]
-            x, y, spd, acc, along = x[keep], y[keep], spd[keep], acc[keep], along[keep]
-        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=spd * along, a=acc * along, types=tuple(types))
+            x, y, v, a = x[keep], y[keep], v[keep], a[keep]
+        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=v, a=a, types=tuple(types))
 
     def _drop_departed(self, ids: list[str], num: np.ndarray) -> None:
         """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
