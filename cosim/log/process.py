@@ -29,6 +29,7 @@ import contextlib
 import fcntl
 import itertools
 import multiprocessing
+import os
 import signal
 import sys
 import threading
@@ -41,7 +42,7 @@ from typing import Any
 
 from cosim.errors import LogError
 
-__all__ = ["ORPHANED", "LogProcess", "pack_frames", "unpack_frames", "writer_process_possible"]
+__all__ = ["ORPHANED", "WRITER_NICENESS", "LogProcess", "pack_frames", "unpack_frames", "writer_process_possible"]
 
 #: The final status message of a log whose run's process died before it closed the log.
 ORPHANED = "the run's process ended without finishing its log (killed, e.g. SIGKILL or out of memory)"
@@ -50,6 +51,8 @@ ORPHANED = "the run's process ended without finishing its log (killed, e.g. SIGK
 PIPE_BYTES = 1 << 20
 #: How long closing waits for the child to finish the file, s.
 CLOSE_TIMEOUT = 120.0
+#: How much nicer (lower priority) the writer process is than the run.
+WRITER_NICENESS = 10
 _F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)
 _STOPS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
@@ -114,6 +117,10 @@ def _child(commands: Connection, replies: Connection, parent_ends: tuple[Connect
     for signum in _STOPS:  # blocked by the parent around the fork: ignored before they can arrive
         signal.signal(signum, signal.SIG_IGN)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
+    # The run's threads set its pace; the writer has the pipe's slack and catches up when a core is free. On two
+    # cores a nicer writer took 5-10 % off a logged run's wall time (10 minutes of the default run, direct basis).
+    with contextlib.suppress(OSError):
+        os.nice(WRITER_NICENESS)
     for end in parent_ends:  # else the run's death would not end the pipe (EOF) here
         end.close()
     # Whatever happens here is the run's to report (through the replies) or nobody's: a run that stopped

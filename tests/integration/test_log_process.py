@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import datetime
+import os
 import threading
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from mcap.reader import make_reader
 from cosim.core.traffic import Frame
 from cosim.errors import ConfigError, LogError
 from cosim.log import TOPIC_SENSORS, TOPIC_STATUS, read_log
-from cosim.log.process import LogProcess, pack_frames, unpack_frames, writer_process_possible
+from cosim.log.process import WRITER_NICENESS, LogProcess, pack_frames, unpack_frames, writer_process_possible
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
 
@@ -134,3 +135,13 @@ def test_frames_packed_for_the_pipe_come_back_equal_bit_for_bit() -> None:
         for column in ("x", "y", "v", "a"):
             assert getattr(got, column).tobytes() == getattr(sent, column).tobytes()  # the same doubles
     assert unpack_frames(pack_frames([])) == []
+
+
+def test_the_writer_process_runs_nicer_than_the_run(tmp_path: Path) -> None:
+    log = LogProcess(tmp_path / "run.mcap", ["mid"])
+    try:
+        ours = os.getpriority(os.PRIO_PROCESS, 0)
+        # The child lowered its priority before it said it was ready (Linux caps niceness at 19).
+        assert os.getpriority(os.PRIO_PROCESS, log._process.pid) == min(ours + WRITER_NICENESS, 19)
+    finally:
+        log.close()
