@@ -75,7 +75,7 @@ out = {"log_bytes": 0}
 started = time.perf_counter()
 if mode == "sumo":
     from cosim.run.simulate import build_traffic
-    with build_traffic(scenario) as traffic:
+    with build_traffic(scenario, process=False) as traffic:  # SUMO and the adapter, in this process
         for _ in range(int(round(duration / scenario.traffic.step))):
             traffic.advance()
 elif "+log" in mode:

@@ -9,9 +9,10 @@ gone. :class:`ScriptedTraffic` is the source for runs without SUMO.
 """
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -289,6 +290,32 @@ class Frame:
     v: npt.NDArray[np.float64]
     a: npt.NDArray[np.float64]
     types: tuple[str, ...]
+
+
+def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
+    """Frames as a few flat columns, to send to another process: pickling each frame's four small arrays cost
+    the run's thread more than all its blocks (0.19 s of 0.28 s in 10 min of the default run)."""
+    if not frames:
+        return ()
+    return ([f.t for f in frames], [len(f.ids) for f in frames],
+            tuple(itertools.chain.from_iterable(f.ids for f in frames)),
+            tuple(itertools.chain.from_iterable(f.types for f in frames)),
+            *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")))
+
+
+def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
+    """The frames of :func:`pack_frames`, equal to those packed (the same numbers, bit for bit)."""
+    if not packed:
+        return []
+    times, counts, ids, types, x, y, v, a = packed
+    out = []
+    start = 0
+    for t, n in zip(times, counts):
+        end = start + n
+        out.append(Frame(t=t, ids=ids[start:end], x=x[start:end], y=y[start:end], v=v[start:end], a=a[start:end],
+                         types=types[start:end]))
+        start = end
+    return out
 
 
 class FrameTraffic:

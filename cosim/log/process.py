@@ -21,13 +21,12 @@ out-of-memory killer) the child still finishes it, with status "error" and
 its next block as a :class:`cosim.errors.LogError`.
 
 Only where forking is safe: Linux, the main thread of a process that may have
-children (:func:`writer_process_possible`); elsewhere runs log from a thread.
+children (:func:`fork_possible`); elsewhere runs log from a thread.
 """
 from __future__ import annotations
 
 import contextlib
 import fcntl
-import itertools
 import multiprocessing
 import os
 import signal
@@ -40,9 +39,10 @@ from multiprocessing.connection import Connection
 from pathlib import Path
 from typing import Any
 
+from cosim.core.traffic import pack_frames, unpack_frames
 from cosim.errors import LogError
 
-__all__ = ["ORPHANED", "WRITER_NICENESS", "LogProcess", "pack_frames", "unpack_frames", "writer_process_possible"]
+__all__ = ["ORPHANED", "STOP_SIGNALS", "WRITER_NICENESS", "LogProcess", "fork_possible", "signals_held"]
 
 #: The final status message of a log whose run's process died before it closed the log.
 ORPHANED = "the run's process ended without finishing its log (killed, e.g. SIGKILL or out of memory)"
@@ -54,51 +54,22 @@ CLOSE_TIMEOUT = 120.0
 #: How much nicer (lower priority) the writer process is than the run.
 WRITER_NICENESS = 10
 _F_SETPIPE_SZ = getattr(fcntl, "F_SETPIPE_SZ", 1031)
-_STOPS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+STOP_SIGNALS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
 
 
-def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
-    """SUMO frames as a few flat columns for the pipe: pickling each frame's four small arrays cost the run's
-    thread more than all its blocks (0.19 s of 0.28 s in 10 min of the default run)."""
-    import numpy as np
-
-    if not frames:
-        return ()
-    return ([f.t for f in frames], [len(f.ids) for f in frames],
-            tuple(itertools.chain.from_iterable(f.ids for f in frames)),
-            tuple(itertools.chain.from_iterable(f.types for f in frames)),
-            *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")))
-
-
-def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
-    """The frames of :func:`pack_frames`, equal to those packed (the same numbers, bit for bit)."""
-    from cosim.core.traffic import Frame
-
-    if not packed:
-        return []
-    times, counts, ids, types, x, y, v, a = packed
-    out = []
-    start = 0
-    for t, n in zip(times, counts):
-        end = start + n
-        out.append(Frame(t=t, ids=ids[start:end], x=x[start:end], y=y[start:end], v=v[start:end], a=a[start:end],
-                         types=types[start:end]))
-        start = end
-    return out
-
-
-def writer_process_possible() -> bool:
-    """Whether a log can be written by a forked child here: Linux, the main thread, a process allowed children."""
+def fork_possible() -> bool:
+    """Whether work can go to a forked child here (the log writer, SUMO): Linux, the main thread, a process
+    allowed children."""
     return (sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
             and threading.current_thread() is threading.main_thread()
             and not multiprocessing.current_process().daemon)
 
 
 @contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
+def signals_held() -> Iterator[None]:
     """The stop signals wait (blocked, then delivered) until a message is wholly in or out of a pipe: a signal
     handler raising in the middle of one would leave the child reading the rest of a message never sent."""
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
     try:
         yield
     finally:
@@ -114,9 +85,9 @@ def _first_line(exc: BaseException) -> str:
 def _child(commands: Connection, replies: Connection, parent_ends: tuple[Connection, ...], path: Path,
            names: list[str], scene: bool) -> None:
     """The child's loop: create the recorder, then do what the run sends until it says close (or dies)."""
-    for signum in _STOPS:  # blocked by the parent around the fork: ignored before they can arrive
+    for signum in STOP_SIGNALS:  # blocked by the parent around the fork: ignored before they can arrive
         signal.signal(signum, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOPS)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
     # The run's threads set its pace; the writer has the pipe's slack and catches up when a core is free. On two
     # cores a nicer writer took 5-10 % off a logged run's wall time (10 minutes of the default run, direct basis).
     with contextlib.suppress(OSError):
@@ -201,7 +172,7 @@ class LogProcess:
         replies_in, replies_out = context.Pipe(duplex=False)
         with contextlib.suppress(OSError):  # a smaller pipe only makes the run wait sooner
             fcntl.fcntl(commands_out.fileno(), _F_SETPIPE_SZ, PIPE_BYTES)
-        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPS)
+        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
         try:
             self._process = context.Process(
                 target=_child, name="cosim-log-writer", daemon=False,
@@ -232,7 +203,7 @@ class LogProcess:
 
     def _reply(self) -> tuple[str, str | None]:
         try:
-            with _signals_held():
+            with signals_held():
                 return self._replies.recv()
         except (EOFError, OSError):
             return "error", f"{self.path}: the log writer process ended unexpectedly " \
@@ -243,7 +214,7 @@ class LogProcess:
             raise LogError(f"{self.path}: the log is already closed")
         self.check()
         try:
-            with _signals_held():
+            with signals_held():
                 self._commands.send(message)
         except OSError as exc:
             raise LogError(f"{self.path}: the log writer process is gone ({exc.strerror or exc})") from None

@@ -33,7 +33,7 @@ from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
-from cosim.log.process import LogProcess, writer_process_possible
+from cosim.log.process import LogProcess, fork_possible
 from cosim.log.scene import ScenePlan, plan_scene, scene_sensors, scene_wanted
 from cosim.log.schemas import (
     LAYOUT_ATTACHMENT,
@@ -291,8 +291,8 @@ def run_logged(
                           "nothing to simulate in time")
     if writer not in LOG_WRITERS:
         raise ConfigError(f"run_logged: `writer` must be one of {', '.join(LOG_WRITERS)} (got {writer!r})")
-    in_process = writer == "process" or (writer == "auto" and writer_process_possible())
-    if in_process and not writer_process_possible():
+    in_process = writer == "process" or (writer == "auto" and fork_possible())
+    if in_process and not fork_possible():
         raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "
                           "may start children; use \"thread\" or \"auto\"")
     started = started or datetime.datetime.now().astimezone()
@@ -362,7 +362,9 @@ def run_logged(
     with stop_signals() as guard, contextlib.ExitStack() as sumo:
         try:
             if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
-                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan))
+                # SUMO stays in this process: with the log writer process beside it, a SUMO process of its own
+                # made logged runs 5-15 % slower on two cores (benchmarks/bench_day.py; it pays without a log).
+                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan, process=False))
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None

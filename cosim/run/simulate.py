@@ -152,13 +152,16 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
 
 
 def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = None,
-                  plan: SumoPlan | None = None) -> Any:
-    """The scenario's traffic source: :class:`cosim.sumo.adapter.SumoTraffic` (not started) for
-    ``[traffic]``, else its scripted vehicles (:meth:`Scenario.build_vehicles`).
+                  plan: SumoPlan | None = None, process: bool | None = None) -> Any:
+    """The scenario's traffic source: for ``[traffic]``, SUMO (not started) in a child process
+    (:class:`cosim.run.sumo_process.SumoProcess`) or in this one (:class:`cosim.sumo.adapter.SumoTraffic`);
+    else its scripted vehicles (:meth:`Scenario.build_vehicles`).
 
     Args:
         frame_sink: with SUMO, called with every frame (e.g. to log it).
         plan: with SUMO, the run's :func:`plan_sumo` if already made.
+        process: SUMO in a child process (the same frames; the run's process keeps its GIL); None: where a
+            child can be forked (:func:`cosim.log.process.fork_possible`).
     """
     if scenario.traffic is None:
         return scenario.build_vehicles()
@@ -167,8 +170,15 @@ def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = N
     t = scenario.traffic
     plan = plan or plan_sumo(scenario)
     with scenario.named("traffic"):
-        return SumoTraffic(plan.config, plan.axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
-                           seed=t.seed, deck_y=plan.deck_y, frame_sink=frame_sink, demand=plan.demand)
+        traffic = SumoTraffic(plan.config, plan.axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
+                              seed=t.seed, deck_y=plan.deck_y, frame_sink=frame_sink, demand=plan.demand)
+    from cosim.log.process import fork_possible
+
+    if process or (process is None and fork_possible()):
+        from .sumo_process import SumoProcess
+
+        return SumoProcess(traffic)
+    return traffic
 
 
 def simulate_scenario(

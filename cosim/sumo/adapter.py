@@ -48,7 +48,7 @@ from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bri
 from cosim.sumo.vtypes import VehicleType, vehicle_type
 
 __all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic",
-           "bundled_networks", "sumo_binary"]
+           "bundled_networks", "follow_frames", "sumo_binary"]
 
 #: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
 WATCH_MARGIN = 12.0
@@ -451,18 +451,25 @@ class SumoTraffic:
 
     def block(self, times: np.ndarray) -> TrafficBlock:
         """Run SUMO as far as ``times`` (s from ``begin``) need and interpolate the vehicles there."""
-        if self.frames is None:
-            raise SumoError("SumoTraffic.start() was not called")
-        while self.frames.last_time < times[-1] - 1e-9:
-            if self.begin + self.frames.last_time + self.step > self.end + 1e-9:
-                raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
-            frame = self.advance()
-            self.frames.add_frame(frame)
-            if self.frame_sink is not None:
-                self.frame_sink(frame, self.models)
-        out = self.frames.block(times)
-        self.frames.forget_before(float(times[-1]))
-        return out
+        return follow_frames(self, times, self.advance)
+
+
+def follow_frames(source: Any, times: np.ndarray, next_frame: Callable[[], Frame]) -> TrafficBlock:
+    """The block of a live SUMO source (its ``frames``, ``frame_sink``, ``models``, ``begin``, ``end``, ``step``)
+    at ``times``, taking SUMO's frames from ``next_frame`` (SUMO stepped here or in a child process) as far as
+    they need, each given to the frame sink as it comes."""
+    if source.frames is None:
+        raise SumoError(f"{type(source).__name__}.start() was not called")
+    while source.frames.last_time < times[-1] - 1e-9:
+        if source.begin + source.frames.last_time + source.step > source.end + 1e-9:
+            raise SumoError(f"SUMO's run ends at {source.end} s; the co-simulation asked for {times[-1]} s")
+        frame = next_frame()
+        source.frames.add_frame(frame)
+        if source.frame_sink is not None:
+            source.frame_sink(frame, source.models)
+    out = source.frames.block(times)
+    source.frames.forget_before(float(times[-1]))
+    return out
 
 
 def _first_line(exc: BaseException) -> str:

@@ -11,10 +11,10 @@ import pytest
 from _cli import bundled_scenario
 from mcap.reader import make_reader
 
-from cosim.core.traffic import Frame
+from cosim.core.traffic import Frame, pack_frames, unpack_frames
 from cosim.errors import ConfigError, LogError
 from cosim.log import TOPIC_SENSORS, TOPIC_STATUS, read_log
-from cosim.log.process import WRITER_NICENESS, LogProcess, pack_frames, unpack_frames, writer_process_possible
+from cosim.log.process import WRITER_NICENESS, LogProcess, fork_possible
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
 
@@ -22,7 +22,7 @@ STARTED = datetime.datetime(2026, 1, 1, tzinfo=datetime.timezone.utc)
 #: SUMO's messages name its scratch folder (a new one per run): not compared.
 SCRATCH_NAMED = {"sumo-messages.log"}
 
-pytestmark = pytest.mark.skipif(not writer_process_possible(), reason="the log writer process needs Linux and fork")
+pytestmark = pytest.mark.skipif(not fork_possible(), reason="the log writer process needs Linux and fork")
 
 
 def log_records(path: Path) -> tuple[list, list, list]:

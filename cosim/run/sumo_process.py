@@ -1,0 +1,252 @@
+"""SUMO in a child process: the run's process keeps its GIL for the bridge, its observers and the log.
+
+libsumo runs SUMO inside the calling process and holds the GIL for every
+step; the adapter's Python per step (:class:`cosim.sumo.adapter.SumoTraffic`)
+needs it too. In the run's process they took turns with the solver thread's
+Python and the observers, so SUMO's own pace was lost (a third of a logged
+run's wall time on two cores). :class:`SumoProcess` forks a child that owns
+the :class:`~cosim.sumo.adapter.SumoTraffic`, steps SUMO ahead of the run and
+sends its frames through a pipe, a second of SUMO time at a time; the pipe's
+size bounds how far ahead it runs. The run takes the frames one at a time
+exactly as it would step SUMO itself (the same frames, the same frame sink
+calls in the same order), so its numbers and its log are the same to the bit.
+
+The child ignores the stop signals (a terminal's Ctrl-C reaches the whole
+process group: the run decides how to stop and closes SUMO through the pipe);
+when the run's process dies, the pipe breaks and the child closes SUMO and
+removes its scratch folder. An error in the child (SUMO failed, a vType that
+cannot be modelled) is raised in the run as the same :mod:`cosim.errors` type
+with the same message, at the frame where it happened.
+
+Only where forking is safe (:func:`cosim.log.process.fork_possible`); elsewhere
+(Dask worker threads, macOS, Windows) SUMO runs in the run's process as before.
+"""
+from __future__ import annotations
+
+import collections
+import contextlib
+import json
+import multiprocessing
+import signal
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from typing import Any
+
+import numpy as np
+
+from cosim import errors
+from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, pack_frames, unpack_frames
+from cosim.core.vehicles import VehicleModel
+from cosim.log.process import STOP_SIGNALS, signals_held
+from cosim.sumo.adapter import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT, SumoTraffic, follow_frames
+from cosim.sumo.vtypes import VehicleType
+
+__all__ = ["AHEAD_SECONDS", "SumoProcess"]
+
+#: SUMO time sent to the run at once, s (the child steps SUMO ahead of the run by a few of these at most).
+AHEAD_SECONDS = 1.0
+#: How long closing waits for the child to close SUMO, s.
+CLOSE_TIMEOUT = 60.0
+
+
+def _error(kind: str, message: str) -> errors.CosimError:
+    """The child's error as the run raises it: the same cosim error type, else a SUMO error."""
+    cls = getattr(errors, kind, None)
+    if not (isinstance(cls, type) and issubclass(cls, errors.CosimError)):
+        cls = errors.SumoError
+    return cls(message)
+
+
+def _child(traffic: SumoTraffic, out: Connection, control: Connection, parent_ends: tuple[Connection, ...]) -> None:
+    for signum in STOP_SIGNALS:  # blocked by the parent around the fork: ignored before they can arrive
+        signal.signal(signum, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
+    for end in parent_ends:  # else the run's death would not break the pipe here
+        end.close()
+    with contextlib.suppress(BaseException):  # whatever happens here is the run's to report, or nobody's
+        _serve(traffic, out, control)
+
+
+def _serve(traffic: SumoTraffic, out: Connection, control: Connection) -> None:
+    traffic.frame_sink = None  # the run's sink gets the frames in the run
+    try:
+        traffic.start()
+    except BaseException as exc:  # noqa: BLE001 - reported to the run, which raises it
+        out.send(("error", type(exc).__name__, str(exc)))
+        return
+    try:
+        out.send(("started", {
+            "edges": traffic.edges, "lanes": traffic.lanes, "deck_lanes": traffic.deck_lanes, "reach": traffic.reach,
+            "types": dict(traffic.types), "models": dict(traffic.models),
+            "table": json.dumps([t.summary() for t in traffic.table()], indent=1)}))
+        per_message = max(1, int(round(AHEAD_SECONDS / traffic.step)))
+        sent_types: set[str] = set(traffic.types)
+        sent_models: set[str] = set(traffic.models)
+        while not control.poll():
+            batch: list[Frame] = []
+            error: tuple[str, str] | None = None
+            while len(batch) < per_message and \
+                    traffic.begin + (traffic.sumo_steps + 1) * traffic.step <= traffic.end + 1e-9:
+                try:
+                    batch.append(traffic.advance())
+                except BaseException as exc:  # noqa: BLE001 - after the frames before it
+                    error = (type(exc).__name__, str(exc))
+                    break
+            new_types = {k: v for k, v in traffic.types.items() if k not in sent_types}
+            new_models = {k: v for k, v in traffic.models.items() if k not in sent_models}
+            sent_types.update(new_types)
+            sent_models.update(new_models)
+            out.send(("frames", pack_frames(batch), new_types, new_models, traffic.teleports))
+            if error is not None:
+                out.send(("error", *error))
+                break
+            if not batch:  # SUMO's end: nothing more to step, wait for the run to close
+                control.poll(None)
+                break
+        if control.poll():
+            control.recv()
+    finally:
+        traffic.close()
+        with contextlib.suppress(OSError):
+            out.send(("closed", traffic.messages, traffic.teleports))
+
+
+class SumoProcess:
+    """A :class:`cosim.sumo.adapter.SumoTraffic` stepped in a forked child; the same traffic-source interface.
+
+    Args:
+        traffic: the SUMO traffic, not started (it is started in the child).
+    """
+
+    def __init__(self, traffic: SumoTraffic) -> None:
+        self.traffic = traffic
+        self.config, self.axis, self.step = traffic.config, traffic.axis, traffic.step
+        self.begin, self.end, self.seed, self.deck_y = traffic.begin, traffic.end, traffic.seed, traffic.deck_y
+        self.frame_sink: Callable[[Frame, dict[str, VehicleModel]], None] | None = traffic.frame_sink
+        self.edges: tuple[str, ...] = ()
+        self.lanes: tuple[str, ...] = ()
+        self.deck_lanes: tuple[str, ...] = ()
+        self.reach = traffic.reach
+        self.models: dict[str, VehicleModel] = {}
+        self.types: dict[str, VehicleType] = {}
+        self.frames: FrameTraffic | None = None
+        self.sumo_steps = 0
+        self.teleports = 0  # as counted by the child, which runs up to AHEAD_SECONDS (and the pipe) ahead
+        self.messages = ""
+        self._table = "[]"
+        self._waiting: collections.deque[Frame] = collections.deque()
+        self._failed: errors.CosimError | None = None
+        self._process: Any = None
+        self._out: Connection | None = None
+        self._control: Connection | None = None
+
+    # ------------------------------------------------------------- lifecycle
+    def start(self) -> SumoProcess:
+        context = multiprocessing.get_context("fork")
+        out_recv, out_send = context.Pipe(duplex=False)
+        control_recv, control_send = context.Pipe(duplex=False)
+        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+        try:
+            self._process = context.Process(target=_child, name="cosim-sumo", daemon=False,
+                                            args=(self.traffic, out_send, control_recv, (out_recv, control_send)))
+            self._process.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+        out_send.close()
+        control_recv.close()
+        self._out, self._control = out_recv, control_send
+        try:
+            message = self._receive()
+        except BaseException:  # a stop signal while SUMO starts: stop the child, leave nothing behind
+            self.close()
+            raise
+        if message[0] != "started":
+            self.close()
+            raise self._failed or errors.SumoError(f"{self.config}: SUMO's process did not start")
+        state = message[1]
+        self.edges, self.lanes, self.deck_lanes, self.reach = (state["edges"], state["lanes"], state["deck_lanes"],
+                                                               state["reach"])
+        self.types.update(state["types"])
+        self.models.update(state["models"])
+        self._table = state["table"]
+        attach = getattr(self.frame_sink, "attach", None)
+        if attach is not None:
+            attach(VEHICLE_TYPES_ATTACHMENT, self._table, "application/json")
+        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
+        return self
+
+    def __enter__(self) -> SumoProcess:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close SUMO in the child (its messages come back and go to the frame sink, as the adapter's do)."""
+        if self._process is None:
+            return
+        process, self._process = self._process, None
+        closed = False
+        try:
+            with signals_held():
+                assert self._control is not None
+                with contextlib.suppress(OSError):
+                    self._control.send(("close",))
+                while self._out is not None and self._out.poll(CLOSE_TIMEOUT):
+                    message = self._out.recv()
+                    if message[0] == "closed":
+                        self.messages, self.teleports = message[1], message[2]
+                        closed = True
+                        break
+        except (EOFError, OSError):
+            pass
+        finally:
+            for end in (self._out, self._control):
+                if end is not None:
+                    end.close()
+            self._out = self._control = None
+            process.join(CLOSE_TIMEOUT if closed else 1.0)
+            if process.is_alive():
+                process.kill()
+                process.join()
+        attach = getattr(self.frame_sink, "attach", None)
+        if attach is not None and self.messages:
+            with contextlib.suppress(Exception):  # the log may already be closed (its own failure)
+                attach(MESSAGES_FILE, self.messages, "text/plain")
+
+    # --------------------------------------------------------------- frames
+    def _receive(self) -> tuple:
+        if self._out is None:
+            raise errors.SumoError(f"{self.config}: SUMO is not running")
+        try:
+            with signals_held():
+                message = self._out.recv()
+        except (EOFError, OSError):
+            code = self._process.exitcode if self._process is not None else None
+            raise errors.SumoError(f"{self.config}: SUMO's process ended unexpectedly (exit status {code})") \
+                from None
+        if message[0] == "error":
+            self._failed = _error(message[1], message[2])
+            raise self._failed
+        return message
+
+    def _next_frame(self) -> Frame:
+        while not self._waiting:
+            if self._failed is not None:
+                raise self._failed
+            message = self._receive()
+            if message[0] == "frames":
+                _, packed, new_types, models, self.teleports = message
+                self.types.update(new_types)
+                self.models.update(models)  # the same dict FrameTraffic holds: a new type is known at once
+                self._waiting.extend(unpack_frames(packed))
+        self.sumo_steps += 1
+        return self._waiting.popleft()
+
+    def block(self, times: np.ndarray) -> TrafficBlock:
+        """As :meth:`cosim.sumo.adapter.SumoTraffic.block`, with the frames the child sends."""
+        return follow_frames(self, times, self._next_frame)
+
+    def log_documents(self, attach: Callable[[str, bytes | str, str], None]) -> None:
+        """Attach the vehicle-type table to a log opened after the start."""
+        attach(VEHICLE_TYPES_ATTACHMENT, self._table, "application/json")
