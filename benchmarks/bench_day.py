@@ -11,12 +11,13 @@ log at 100 Hz), for the chosen number of simulated hours:
   for every SUMO step, no bridge);
 - the co-simulation with the direct (full FE) and the modal (30 modes) basis,
   with and without the MCAP log, through the same code as `cosim run`
-  (`run_logged` with the log; `simulate` in constant memory without);
+  (`run_logged` with the log; `simulate` in constant memory without, with SUMO
+  stepped in a child process as `build_traffic` gives it: `cosim.run.sumo_process`);
 - direct + log with the log encoded in a thread of the run's process
   (`direct+log/thread`) instead of the log writer process (`cosim.log.process`);
 - the real-time factor of direct + log at dt = 5 ms and 1 ms;
-- wall time, the ratio to SUMO alone, peak memory (max RSS of the run and of its log writer process)
-  and log size.
+- wall time, the ratio to SUMO alone, peak memory (max RSS of the run and of its child process: the
+  log writer with a log, SUMO without) and log size.
 
 Each configuration runs in its own process (libsumo is a per-process
 singleton); ratios come from the same run, so machine speed cancels. Then,
@@ -92,7 +93,7 @@ else:
     out["vehicles"] = len({v.split("#")[0] for v in res.vehicle_ids})
 out["wall"] = time.perf_counter() - started
 out["max_rss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-out["writer_rss_mb"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0  # the log writer process
+out["writer_rss_mb"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024.0  # the log writer or SUMO
 print(json.dumps(out))
 """
 
@@ -186,8 +187,8 @@ def main(argv: list[str] | None = None) -> int:
         f"{args.reps}; ratios: each run against SUMO alone of the same repetition (run first in it), the "
         "median over the repetitions and, in brackets, their range.",
         "",
-        "Peak memory: the run's process, and its log writer process (a fork: pages it shares with the run "
-        "count in both).",
+        "Peak memory: the run's process, and its child (a fork: pages it shares with the run count in both): "
+        "the log writer process with a log; SUMO's process without (`cosim.run.sumo_process`).",
         "",
         "| run | wall [s] | real-time factor | / SUMO alone | peak memory [MB] | log [MB] | vehicles |",
         "|---|---|---|---|---|---|---|",

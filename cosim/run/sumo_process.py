@@ -27,7 +27,6 @@ import collections
 import contextlib
 import json
 import multiprocessing
-import signal
 from collections.abc import Callable
 from multiprocessing.connection import Connection
 from typing import Any
@@ -37,7 +36,7 @@ import numpy as np
 from cosim import errors
 from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, pack_frames, unpack_frames
 from cosim.core.vehicles import VehicleModel
-from cosim.log.process import STOP_SIGNALS, signals_held
+from cosim.log.process import fork_child, signals_held
 from cosim.sumo.adapter import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT, SumoTraffic, follow_frames
 from cosim.sumo.vtypes import VehicleType
 
@@ -55,16 +54,6 @@ def _error(kind: str, message: str) -> errors.CosimError:
     if not (isinstance(cls, type) and issubclass(cls, errors.CosimError)):
         cls = errors.SumoError
     return cls(message)
-
-
-def _child(traffic: SumoTraffic, out: Connection, control: Connection, parent_ends: tuple[Connection, ...]) -> None:
-    for signum in STOP_SIGNALS:  # blocked by the parent around the fork: ignored before they can arrive
-        signal.signal(signum, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
-    for end in parent_ends:  # else the run's death would not break the pipe here
-        end.close()
-    with contextlib.suppress(BaseException):  # whatever happens here is the run's to report, or nobody's
-        _serve(traffic, out, control)
 
 
 def _serve(traffic: SumoTraffic, out: Connection, control: Connection) -> None:
@@ -145,15 +134,8 @@ class SumoProcess:
         context = multiprocessing.get_context("fork")
         out_recv, out_send = context.Pipe(duplex=False)
         control_recv, control_send = context.Pipe(duplex=False)
-        old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
-        try:
-            self._process = context.Process(target=_child, name="cosim-sumo", daemon=False,
-                                            args=(self.traffic, out_send, control_recv, (out_recv, control_send)))
-            self._process.start()
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
-        out_send.close()
-        control_recv.close()
+        self._process = fork_child("cosim-sumo", _serve, (self.traffic, out_send, control_recv),
+                                   child_ends=(out_send, control_recv), parent_ends=(out_recv, control_send))
         self._out, self._control = out_recv, control_send
         try:
             message = self._receive()

@@ -126,3 +126,21 @@ def bundled_scenario(name: str, *, end: float | None = None, dt: float | None = 
     if dt is not None:
         data["solver"]["dt"] = dt
     return parse_scenario(toml_dumps(data), name, base_dir=base.base_dir)
+
+
+def broken_sumo_configs(folder: Path) -> tuple[Path, Path]:
+    """Two SUMO configs written into ``folder``: one cosim cannot read (its network is missing) and one cosim
+    reads but SUMO cannot load (a route over an edge the bundled network does not have)."""
+    import shutil
+
+    from cosim.sumo.adapter import bundled_networks
+
+    broken = folder / "broken.sumocfg"
+    broken.write_text("<configuration><input><net-file value='nope.net.xml'/></input></configuration>")
+    shutil.copy(bundled_networks() / "bridge.net.xml", folder / "bridge.net.xml")
+    (folder / "bad.rou.xml").write_text('<routes><vehicle id="v" depart="0"><route edges="nowhere"/></vehicle>'
+                                        '</routes>')
+    unknown = folder / "unknown.sumocfg"
+    unknown.write_text('<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/>'
+                       '</input></configuration>')
+    return broken, unknown

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _cli import bundled_scenario
+from _cli import broken_sumo_configs, bundled_scenario
 
 from cosim.core.bridge import PointLoad
 from cosim.core.sensors import Sensor
@@ -140,17 +140,10 @@ def test_a_queue_stopped_on_the_deck_gives_the_static_deflection(paper_bridge, t
 def test_sumo_errors_are_reported_clearly(tmp_path):
     with pytest.raises(SumoError, match="SUMO config not found"):
         SumoTraffic(tmp_path / "missing.sumocfg", AXIS)
-    broken = tmp_path / "broken.sumocfg"
-    broken.write_text("<configuration><input><net-file value='nope.net.xml'/></input></configuration>")
+    broken, unknown = broken_sumo_configs(tmp_path)
     with pytest.raises(ConfigError, match=r"broken\.sumocfg: net-file: cannot read .*nope\.net\.xml"):
         SumoTraffic(broken, AXIS).start()
     # A config cosim can read but SUMO cannot load: SUMO's own first error line, not libsumo's "Process Error".
-    shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
-    (tmp_path / "bad.rou.xml").write_text('<routes><vehicle id="v" depart="0"><route edges="nowhere"/></vehicle>'
-                                         '</routes>')
-    unknown = tmp_path / "unknown.sumocfg"
-    unknown.write_text('<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/>'
-                       '</input></configuration>')
     with pytest.raises(SumoError, match=r"SUMO could not load it: .*nowhere"):
         SumoTraffic(unknown, AXIS).start()
     with pytest.raises(SumoError, match="has no edge 'no_such_edge'"):

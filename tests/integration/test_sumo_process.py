@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -11,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _cli import bundled_scenario
+from _cli import broken_sumo_configs, bundled_scenario
 
 from cosim.core.simulation import simulate
 from cosim.errors import ConfigError, SumoError
@@ -46,14 +45,7 @@ def test_sumo_in_its_own_process_gives_the_same_run_to_the_bit() -> None:
 
 
 def test_errors_of_sumo_in_its_process_are_those_of_sumo_here(tmp_path: Path) -> None:
-    broken = tmp_path / "broken.sumocfg"
-    broken.write_text("<configuration><input><net-file value='nope.net.xml'/></input></configuration>")
-    shutil.copy(bundled_networks() / "bridge.net.xml", tmp_path / "bridge.net.xml")
-    (tmp_path / "bad.rou.xml").write_text('<routes><vehicle id="v" depart="0"><route edges="nowhere"/></vehicle>'
-                                         '</routes>')
-    unknown = tmp_path / "unknown.sumocfg"
-    unknown.write_text('<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/>'
-                       '</input></configuration>')
+    broken, unknown = broken_sumo_configs(tmp_path)
     for config, kind in ((broken, ConfigError), (unknown, SumoError)):
         with pytest.raises(kind) as here:
             SumoTraffic(config, AXIS).start()
