@@ -72,6 +72,15 @@ from cosim.core.sensors import Sensor
 from cosim.core.simulation import simulate
 from cosim.core.traffic import ScriptedTraffic
 simulate(bridge, ScriptedTraffic((), bridge.length), 0.05, scenario.solver_settings(), [Sensor("s", 1.0)])
+# ... and every compiled function of a SUMO run (projection, interpolation, road, extremes): 20 s of traffic.
+from cosim.run.simulate import build_traffic
+warm = tomllib.loads(toml_dumps(data))
+warm["traffic"]["end"] = 20.0
+warm = parse_scenario(toml_dumps(warm), "warm-up", base_dir=base.base_dir)
+# SUMO where the timed run has it: in a child without a log (the parent's memory stays the run's own).
+with build_traffic(warm, process=mode in ("direct", "modal")) as traffic:
+    simulate(bridge, traffic, 20.0, warm.solver_settings(), warm.sensors_core(), road=warm.build_road(),
+             output_every=warm.output_every, collect=False)
 out = {"log_bytes": 0}
 started = time.perf_counter()
 if mode == "sumo":
