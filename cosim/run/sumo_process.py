@@ -1,15 +1,18 @@
-"""SUMO in a child process: the run's process keeps its GIL for the bridge, its observers and the log.
+"""SUMO in a child process: the run's process keeps its GIL for the bridge and its observers.
 
 libsumo runs SUMO inside the calling process and holds the GIL for every
 step; the adapter's Python per step (:class:`cosim.sumo.adapter.SumoTraffic`)
 needs it too. In the run's process they took turns with the solver thread's
-Python and the observers, so SUMO's own pace was lost (a third of a logged
-run's wall time on two cores). :class:`SumoProcess` forks a child that owns
+Python and the observers: an hour of the default config without a log took
+1.98x SUMO alone there, and 1.51x with SUMO in a child (benchmarks/bench_day.py,
+side by side). Beside the log writer process it did not pay (two children
+and the solver on two cores): :func:`cosim.run.logged.run_logged` keeps SUMO
+in the run's process. :class:`SumoProcess` forks a child that owns
 the :class:`~cosim.sumo.adapter.SumoTraffic`, steps SUMO ahead of the run and
 sends its frames through a pipe, a second of SUMO time at a time; the pipe's
 size bounds how far ahead it runs. The run takes the frames one at a time
 exactly as it would step SUMO itself (the same frames, the same frame sink
-calls in the same order), so its numbers and its log are the same to the bit.
+calls in the same order), so its numbers are the same to the bit.
 
 The child ignores the stop signals (a terminal's Ctrl-C reaches the whole
 process group: the run decides how to stop and closes SUMO through the pipe);
