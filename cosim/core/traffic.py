@@ -472,8 +472,9 @@ def axles_on_axis(vehicles: np.ndarray, back: np.ndarray, owner: np.ndarray, ori
     """Contact points of vehicles in bridge coordinates, from a traffic simulation's vehicle states.
 
     Args:
-        vehicles: (n, 5) per vehicle: front bumper x, y (m, network), heading (degrees, 0 = north, clockwise:
-            SUMO's angle), speed (m/s), acceleration (m/s^2), both along the heading.
+        vehicles: (n, 5 or more) per vehicle: front bumper x, y (m, network), heading (degrees, 0 = north,
+            clockwise: SUMO's angle), speed (m/s), acceleration (m/s^2), both along the heading; columns after
+            these are not read.
         back: (m,) each contact point's distance behind the bumper, m; owner: (m,) its vehicle's row.
         origin: the bridge axis' start (network, m); along, left: unit vectors along the axis and to its left.
         y_range, x_range: the region kept, m (bridge coordinates: the deck's width, the watched reach).

@@ -533,8 +533,8 @@ class SceneWriter:
         y_all = report.y
         forces = report.contact_force[k]
         on_deck = report.on_deck[k]
-        ns = int(round(t * 1e9))
-        sec, nsec = ns // 1_000_000_000, ns % 1_000_000_000
+        stamp = _time(t)
+        sec, nsec = stamp["sec"], stamp["nsec"]
         out = []
         for owner, cols in groups.items():
             cols = [j for j in cols if near[j]]

@@ -609,9 +609,7 @@ class TrafficLogger:
 
     def write_frame(self, frame, models: dict) -> None:
         """Write one frame (and the vehicle types it brings first)."""
-        self._write_types(frame, models)
-        if frame.ids:
-            self.rec.write_encoded(TOPIC_TRAFFIC, [frame.t], [self._encode(frame)])
+        self.write_frames([(frame, models)])
 
     def _write_types(self, frame, models: dict) -> None:
         for typ in frame.types:

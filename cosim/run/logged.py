@@ -291,8 +291,8 @@ def run_logged(
                           "nothing to simulate in time")
     if writer not in LOG_WRITERS:
         raise ConfigError(f"run_logged: `writer` must be one of {', '.join(LOG_WRITERS)} (got {writer!r})")
-    in_process = writer == "process" or (writer == "auto" and fork_possible())
-    if in_process and not fork_possible():
+    writer_child = writer == "process" or (writer == "auto" and fork_possible())
+    if writer_child and not fork_possible():
         raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "
                           "may start children; use \"thread\" or \"auto\"")
     started = started or datetime.datetime.now().astimezone()
@@ -369,13 +369,13 @@ def run_logged(
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
         return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
-                       duration, every, rate_hz, meta, replay, documents, progress, plan, in_process)
+                       duration, every, rate_hz, meta, replay, documents, progress, plan, writer_child)
 
 
 def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,
             live_sumo: bool, road: Any, solver: Any, sensors: list, duration: float, every: int, rate_hz: float,
             meta: dict[str, str], replay: dict[str, str] | None, documents: dict[str, bytes],
-            progress: Callable[[float], None] | None, plan: ScenePlan | None, in_process: bool) -> RunOutcome:
+            progress: Callable[[float], None] | None, plan: ScenePlan | None, writer_child: bool) -> RunOutcome:
     """The log itself: written under a temporary name until the stepping starts, then as ``log_path``."""
     names = [s.name for s in sensors]
     partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
@@ -412,7 +412,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
 
     try:
         try:
-            rec = (LogProcess(partial, names, scene=plan is not None) if in_process else
+            rec = (LogProcess(partial, names, scene=plan is not None) if writer_child else
                    LogRecorder(partial, names, force=False, scene=plan is not None))
         except LogError as exc:  # name the log the user asked for, not its temporary name
             raise LogError(str(exc).replace(str(partial), str(log_path))) from None
