@@ -40,6 +40,7 @@ from cosim.core.bridge import BridgeModel, PointLoad
 from cosim.core.sensors import Sensor, sensor_row
 from cosim.core.traffic import vehicle_of
 
+from .fill import CENTIMETRE, INTEGER, FilledTemplate, holes
 from .schemas import SCENE_FRAME, TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM, WORLD_FRAME
 
 __all__ = ["SCENE_MAX_DURATION", "SCENE_RATE_HZ", "ScenePlan", "SceneWriter", "plan_scene", "scene_sensors",
@@ -258,29 +259,14 @@ def scene_sensors(plan: ScenePlan) -> list[Sensor]:
 # --------------------------------------------------------------------------- encoding
 
 
-def _tokens(values: np.ndarray) -> list[bytes]:
-    """The JSON numbers of an array, flattened, rounded to the drawing's centimetre."""
-    rounded = np.round(np.ascontiguousarray(values, dtype=np.float64), _DECIMALS) + 0.0  # no "-0.0"
-    text = orjson.dumps(rounded.ravel(), option=orjson.OPT_SERIALIZE_NUMPY)
-    return text[1:-1].split(b",") if len(text) > 2 else []
-
-
-def _rows(values: np.ndarray) -> list[tuple[bytes, ...]]:
-    """The JSON numbers of each row of a 2-D array (see :func:`_tokens`), as %-template arguments."""
-    width = values.shape[1]
-    tokens = _tokens(values) if width else []
-    return [tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)] if width else \
-        [() for _ in range(values.shape[0])]
-
-
 def _json(value: Any) -> bytes:
     return orjson.dumps(value)
 
 
 def _template(value: Any) -> bytes:
-    """``value`` as JSON, for a bytes %-template whose ``"%s"`` strings stand for encoded JSON (numbers from
-    :func:`_tokens`, strings) and ``"%r"`` for Python numbers (a rounded float's or an int's repr is the JSON
-    orjson writes for it)."""
+    """``value`` as JSON, for a bytes %-template whose ``"%s"`` strings stand for encoded JSON (numbers filled
+    by :class:`cosim.log.fill.FilledTemplate`, strings) and ``"%r"`` for Python numbers (a rounded float's or an
+    int's repr is the JSON orjson writes for it)."""
     return _json(value).replace(b"%", b"%%").replace(b'"%%s"', b"%s").replace(b'"%%r"', b"%r")
 
 
@@ -300,6 +286,8 @@ def _entity(entity_id: str, t: float, **primitives: Any) -> dict[str, Any]:
 
 
 _Z = "%s"  # a number filled in at every scene
+_ZERO_STAMP = b'"timestamp":{"sec":0,"nsec":0}'  # an entity's timestamp in its template ...
+_OPEN_STAMP = b'"timestamp":{"sec":%s,"nsec":%s}'  # ... and left open for the scene's time
 _R = "%r"  # a Python number filled in at every scene
 
 
@@ -333,8 +321,8 @@ class SceneWriter:
         self._marks = np.array([[s.x, s.y] for s in plan.sensors], dtype=float).reshape(-1, 2)
         self._mark_matrix = self.spline_matrix(self._marks[:, 0])
         self._surface = self._deck_template()
-        self._paths_template = self._path_template()
         self._sensors_template = self._sensor_template()
+        self._scene_fill = self._scene_template()
         self._vehicle_templates: dict[tuple[bool, int, tuple[int, ...]], bytes] = {}
 
     # ------------------------------------------------------------- geometry
@@ -388,6 +376,18 @@ class SceneWriter:
                     "size": {"x": 0.6, "y": 0.6, "z": 0.6}, "color": _QUANTITY_COLORS[s.quantity]}
                    for s in self.plan.sensors]
         return _template(_entity("sensors", 0.0, spheres=spheres))
+
+    def _scene_template(self) -> FilledTemplate:
+        """A scene up to its vehicles: the deck, the wheel paths and the sensors, with their timestamps and
+        drawn heights left open (filled in :meth:`_write`)."""
+        parts = [self._surface, *([self._path_template()] if self.paths else []),
+                 *([self._sensors_template] if self.plan.sensors else [])]
+        entities = [p.replace(_ZERO_STAMP, _OPEN_STAMP, 1) for p in parts]
+        template = b'{"deletions":[{' + _OPEN_STAMP + b',"type":1,"id":""}],"entities":[' + b",".join(entities)
+        kinds = [INTEGER, INTEGER]
+        for p in parts:
+            kinds += [INTEGER, INTEGER] + [CENTIMETRE] * holes(p)
+        return FilledTemplate(template, kinds)
 
     # ------------------------------------------------------------- messages
     def start(self) -> None:
@@ -449,7 +449,7 @@ class SceneWriter:
                 new = True
         if new:
             self.paths.sort()
-            self._paths_template = self._path_template()
+            self._scene_fill = self._scene_template()
 
     def _write(self, times: list[float], sensors: np.ndarray, report: Any, rows: list[int]) -> None:
         """The scenes at ``times`` (their sensor rows ``sensors``, rows ``rows`` of the block), encoded together."""
@@ -468,7 +468,14 @@ class SceneWriter:
         paths = ((w_r[:, None, :] + share[None, :, None] * (w_l - w_r)[:, None, :]) * e + 0.03).reshape(count, -1)
         m_r, m_l = right @ self._mark_matrix.T, left @ self._mark_matrix.T
         marks = (m_r + (self._marks[:, 1] - y_min) / (y_max - y_min) * (m_l - m_r)) * e + 0.3
-        rows_deck, rows_paths, rows_marks = _rows(deck), _rows(paths), _rows(marks)
+        ns = np.rint(np.asarray(times, dtype=np.float64) * 1e9).astype(np.int64)  # as _time
+        stamps = np.column_stack([ns // 1_000_000_000, ns % 1_000_000_000]).astype(np.float64)
+        columns = [stamps, stamps, deck]
+        if self.paths:
+            columns += [stamps, paths]
+        if plan.sensors:
+            columns += [stamps, marks]
+        scenes = self._scene_fill.render(np.concatenate(columns, axis=1))
         vehicles = report is not None and bool(report.ids)
         if vehicles:  # the deck under every contact point at every scene, in one go
             x = np.asarray(report.x, dtype=float)[rows]
@@ -486,21 +493,9 @@ class SceneWriter:
                      for owner, cols in groups.items()}
         datas: list[bytes] = []
         for i, (t, k) in enumerate(zip(times, rows)):
-            stamp = b'"timestamp":' + _json(_time(t))
-            parts = [self._stamp(self._surface % rows_deck[i], stamp)]
-            if self.paths:
-                parts.append(self._stamp(self._paths_template % rows_paths[i], stamp))
-            if plan.sensors:
-                parts.append(self._stamp(self._sensors_template % rows_marks[i], stamp))
-            if vehicles:
-                parts.extend(self._vehicles(t, report, k, groups, heavy, x[i], near[i], z[i]))
-            head = b'{"deletions":[{' + stamp + b',"type":1,"id":""}],"entities":['
-            datas.append(head + b",".join(parts) + b"]}")
+            cars = self._vehicles(t, report, k, groups, heavy, x[i], near[i], z[i]) if vehicles else []
+            datas.append(b",".join([scenes[i], *cars]) + b"]}")
         self.rec.write_encoded(TOPIC_SCENE, times, datas)
-
-    @staticmethod
-    def _stamp(entity: bytes, stamp: bytes) -> bytes:
-        return entity.replace(b'"timestamp":{"sec":0,"nsec":0}', stamp, 1)
 
     def _vehicle_template(self, big: bool, axles: int, arrows: tuple[int, ...]) -> bytes:
         """A vehicle's entity with its numbers left open (``arrows``: per axle 0 none, 1 push, -1 pull), made
