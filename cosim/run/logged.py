@@ -362,14 +362,25 @@ def run_logged(
     with stop_signals() as guard, contextlib.ExitStack() as sumo:
         try:
             if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
-                # SUMO stays in this process: with the log writer process beside it, a SUMO process of its own
-                # made logged runs 5-15 % slower on two cores (benchmarks/bench_day.py; it pays without a log).
-                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan, process=False))
+                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan,
+                                                           process=_sumo_process(plan, writer_child)))
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
         return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
                        duration, every, rate_hz, meta, replay, documents, progress, plan, writer_child)
+
+
+def _sumo_process(plan: ScenePlan | None, writer_child: bool) -> bool | None:
+    """Where SUMO runs in a logged run: its own process (None: where one can be forked) for a log without the 3D
+    scene written by the log writer process, else the run's process (False).
+
+    Measured side by side on two cores, 1 h of the default config, 5 pairs: without the scene, SUMO's own process
+    took direct + log from 2.14x to 1.75x SUMO alone and modal + log from 1.79x to 1.46x. With the scene (about
+    a third of the log writer's CPU) the writer process, SUMO's and the solver no longer fit on the two cores:
+    0-15 % slower.
+    """
+    return None if plan is None and writer_child else False
 
 
 def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,

@@ -116,15 +116,18 @@ dt = 0.002
 """
 
 
-def bundled_scenario(name: str, *, end: float | None = None, dt: float | None = None) -> Scenario:
-    """The bundled scenario ``name`` with its SUMO run's ``[traffic] end`` (s) and ``[solver] dt`` (s) changed,
-    as a user's edited copy of it would be."""
+def bundled_scenario(name: str, *, end: float | None = None, dt: float | None = None,
+                     scene: bool | None = None) -> Scenario:
+    """The bundled scenario ``name`` with its SUMO run's ``[traffic] end`` (s), ``[solver] dt`` (s) and
+    ``[output] scene`` changed, as a user's edited copy of it would be."""
     base = load_scenario(name)
     data = tomllib.loads(base.text)
     if end is not None:
         data["traffic"]["end"] = end
     if dt is not None:
         data["solver"]["dt"] = dt
+    if scene is not None:
+        data.setdefault("output", {})["scene"] = scene
     return parse_scenario(toml_dumps(data), name, base_dir=base.base_dir)
 
 

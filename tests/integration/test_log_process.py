@@ -4,6 +4,7 @@ from __future__ import annotations
 import datetime
 import os
 import threading
+from multiprocessing import active_children
 from pathlib import Path
 
 import numpy as np
@@ -36,18 +37,26 @@ def log_records(path: Path) -> tuple[list, list, list]:
     return messages, attachments, metadata
 
 
-@pytest.mark.parametrize("name, end", [("paper-double-tee", None), ("paper-bridge-traffic", 20.0)])
-def test_the_process_writes_the_same_log_as_the_thread(tmp_path: Path, name: str, end: float | None) -> None:
-    scenario = bundled_scenario(name, end=end)  # SUMO: 20 s of traffic, the 3D scene and SUMO's frames included
+@pytest.mark.parametrize("name, end, scene", [("paper-double-tee", None, None), ("paper-bridge-traffic", 20.0, None),
+                                              ("paper-bridge-traffic", 20.0, False)])
+def test_the_process_writes_the_same_log_as_the_thread(tmp_path: Path, name: str, end: float | None,
+                                                       scene: bool | None) -> None:
+    """SUMO: 20 s of traffic, the 3D scene and SUMO's frames included; without the scene, the run beside the
+    writer process steps SUMO in a process of its own (cosim.run.sumo_process), and the log is still the same."""
+    scenario = bundled_scenario(name, end=end, scene=scene)
     bridge = scenario.build_bridge()
     logs = {}
+    children: dict[str, set[str]] = {"thread": set(), "process": set()}
     for writer in ("thread", "process"):
         logs[writer] = tmp_path / f"{writer}.mcap"
-        run_logged(scenario, logs[writer], bridge=bridge, writer=writer, started=STARTED)
+        run_logged(scenario, logs[writer], bridge=bridge, writer=writer, started=STARTED,
+                   progress=lambda _, seen=children[writer]: seen.update(p.name for p in active_children()))
     thread, process = log_records(logs["thread"]), log_records(logs["process"])
     assert len(thread[0]) > 100  # a run's worth of messages, not an empty comparison
     assert process == thread  # same objects encode the same messages: byte for byte
     assert read_log(logs["process"]).final_status["state"] == "finished"
+    assert children["process"] == {"cosim-log-writer"} | ({"cosim-sumo"} if scene is False else set())
+    assert children["thread"] == set()
 
 
 def test_an_error_in_the_writer_process_is_raised_in_the_run_and_the_log_still_ends(tmp_path: Path) -> None:

@@ -82,6 +82,29 @@ def test_each_signal_finishes_the_log_and_exits_128_plus_its_number(long_folder:
         assert not [p for p in long_folder.iterdir() if ".part" in p.name]
 
 
+def test_ctrl_c_finishes_the_log_of_a_run_whose_sumo_has_a_process_of_its_own(tmp_path: Path) -> None:
+    """Without the 3D scene, a logged run steps SUMO in a child process (cosim.run.sumo_process) beside the log
+    writer's. Ctrl-C reaches all three (the terminal signals the process group): the log is finished, one
+    line is printed, and SUMO's scratch folder is removed."""
+    sumo_folder(tmp_path)
+    write(tmp_path, "run.toml", SUMO_SCENARIO.format(end=3000.0).replace("[output]\n", "[output]\nscene = false\n"))
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    proc = start("run", "run.toml", "--out", "run.mcap", "--quiet", cwd=tmp_path,
+                 env={**cli_env(), "TMPDIR": str(scratch)})
+    wait_for(lambda: (tmp_path / "run.mcap").exists())
+    time.sleep(0.5)
+    children = Path(f"/proc/{proc.pid}/task/{proc.pid}/children").read_text().split()
+    assert len(children) == 2, children  # the log writer's process and SUMO's
+    os.killpg(proc.pid, signal.SIGINT)
+    status, err = finish(proc)
+    assert status == 130, err
+    assert err.strip().splitlines()[-1].startswith("cosim: interrupted by SIGINT at about t = "), err
+    overview = open_log(tmp_path / "run.mcap")
+    assert overview.complete and overview.final_status["state"] == "interrupted"
+    wait_for(lambda: not list(scratch.glob("cosim-sumo-*")), 10)  # SUMO's child closed SUMO and cleaned up
+
+
 def test_a_signal_before_the_run_starts_leaves_no_log(long_folder: Path) -> None:
     """SIGTERM once the log's temporary file exists but the time stepping has not started (the direct
     basis of a 4207-DOF model is being factorised): nothing is left, and the exit status is 143."""
