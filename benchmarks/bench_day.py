@@ -15,9 +15,11 @@ log at 100 Hz), for the chosen number of simulated hours:
   stepped in a child process as `build_traffic` gives it: `cosim.run.sumo_process`);
 - direct + log with the log encoded in a thread of the run's process
   (`direct+log/thread`) instead of the log writer process (`cosim.log.process`);
+- direct + log and modal + log without the 3D scene (`/no-scene`), as a run longer than an hour has them by
+  default: SUMO then steps in a child process beside the log writer's (`cosim.run.logged`);
 - the real-time factor of direct + log at dt = 5 ms and 1 ms;
-- wall time, the ratio to SUMO alone, peak memory (max RSS of the run and of its child process: the
-  log writer with a log, SUMO without) and log size.
+- wall time, the ratio to SUMO alone, peak memory (max RSS of the run and of its largest child process: the
+  log writer or SUMO's) and log size.
 
 Each configuration runs in its own process (libsumo is a per-process
 singleton); ratios come from the same run, so machine speed cancels. Then,
@@ -44,7 +46,8 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS
     os.environ.setdefault(_var, "1")
 
 HERE = Path(__file__).resolve().parent
-RUNS = ("sumo", "direct", "direct+log", "direct+log/thread", "modal", "modal+log", "direct+log@1ms")
+RUNS = ("sumo", "direct", "direct+log", "direct+log/thread", "direct+log/no-scene", "modal", "modal+log",
+        "modal+log/no-scene", "direct+log@1ms")
 DEFAULT_OUT = HERE / "results" / "day.md"
 
 WORKER = r"""
@@ -65,6 +68,8 @@ if basis in ("direct", "modal"):
         data["solver"]["modes"] = 30
 if mode.endswith("@1ms"):
     data["solver"]["dt"] = 0.001
+if mode.endswith("/no-scene"):  # as a run longer than SCENE_MAX_DURATION (or one that says so) has it
+    data.setdefault("output", {})["scene"] = False
 scenario = parse_scenario(toml_dumps(data), f"bench-{mode}", base_dir=base.base_dir)
 bridge = scenario.build_bridge()
 # Compile (or load) the kernels outside the timed part.
@@ -77,8 +82,9 @@ from cosim.run.simulate import build_traffic
 warm = tomllib.loads(toml_dumps(data))
 warm["traffic"]["end"] = 20.0
 warm = parse_scenario(toml_dumps(warm), "warm-up", base_dir=base.base_dir)
-# SUMO where the timed run has it: in a child without a log (the parent's memory stays the run's own).
-with build_traffic(warm, process=mode in ("direct", "modal")) as traffic:
+# SUMO where the timed run has it: in a child without a log or without the scene (the parent's memory stays
+# the run's own).
+with build_traffic(warm, process=mode in ("direct", "modal") or mode.endswith("/no-scene")) as traffic:
     simulate(bridge, traffic, 20.0, warm.solver_settings(), warm.sensors_core(), road=warm.build_road(),
              output_every=warm.output_every, collect=False)
 out = {"log_bytes": 0}
@@ -196,8 +202,9 @@ def main(argv: list[str] | None = None) -> int:
         f"{args.reps}; ratios: each run against SUMO alone of the same repetition (run first in it), the "
         "median over the repetitions and, in brackets, their range.",
         "",
-        "Peak memory: the run's process, and its child (a fork: pages it shares with the run count in both): "
-        "the log writer process with a log; SUMO's process without (`cosim.run.sumo_process`).",
+        "Peak memory: the run's process, and its largest child (a fork: pages it shares with the run count in "
+        "both): the log writer process with a log, SUMO's process without (`cosim.run.sumo_process`); with a log "
+        "but no scene, both are children.",
         "",
         "| run | wall [s] | real-time factor | / SUMO alone | peak memory [MB] | log [MB] | vehicles |",
         "|---|---|---|---|---|---|---|",
