@@ -5,9 +5,10 @@ step; the adapter's Python per step (:class:`cosim.sumo.adapter.SumoTraffic`)
 needs it too. In the run's process they took turns with the solver thread's
 Python and the observers: an hour of the default config without a log took
 1.98x SUMO alone there, and 1.51x with SUMO in a child (benchmarks/bench_day.py,
-side by side). Beside the log writer process it did not pay (two children
-and the solver on two cores): :func:`cosim.run.logged.run_logged` keeps SUMO
-in the run's process. :class:`SumoProcess` forks a child that owns
+side by side). A logged run uses it when its log has no 3D scene; with the
+scene, the log writer process needs the cores' slack and SUMO stays in the
+run's process (:func:`cosim.run.logged._sumo_process` has the measurements).
+:class:`SumoProcess` forks a child that owns
 the :class:`~cosim.sumo.adapter.SumoTraffic`, steps SUMO ahead of the run and
 sends its frames through a pipe, a second of SUMO time at a time; the pipe's
 size bounds how far ahead it runs. The run takes the frames one at a time
