@@ -2,8 +2,8 @@
 
 The 3D scene (:mod:`cosim.log.scene`) writes the same entities at every
 scene with only their numbers changed: the deck's drawn heights and the
-timestamps. Formatting those as one Python object per number cost about a
-fifth of the log writer's CPU; a :class:`FilledTemplate` writes the numbers of
+timestamps. Formatting those as one Python object per number cost a tenth to
+a fifth of the log writer's CPU; a :class:`FilledTemplate` writes the numbers of
 many messages straight into one byte buffer (the writer's CPU for the same
 messages of a 10-minute default run: 1.13-1.65 s before, 1.06-1.31 s after).
 
