@@ -439,6 +439,21 @@ def _ballistic_between_frames(FX: np.ndarray, FV: np.ndarray, FA: np.ndarray, se
     were three dozen passes over small arrays per block, in the thread that runs SUMO. The expressions keep
     numpy's order of operations, so the numbers are the same to the bit."""
     steps, q = len(times), FX.shape[1]
+    # The motion over each interval (frame r to r + 1), once per interval: a block has tens of steps in each.
+    intervals = FX.shape[0] - 1
+    v0s, x0s = np.empty((intervals, q)), np.empty((intervals, q))
+    accs, gaps = np.empty((intervals, q)), np.empty((intervals, q))
+    for r in range(intervals):
+        for j in range(q):
+            v1, a1, x1 = FV[r + 1, j], FA[r + 1, j], FX[r + 1, j]
+            if seen[r, j]:
+                v0, x0 = FV[r, j], FX[r, j]
+            else:  # first seen at frame r + 1: traced back along the same motion
+                v0 = v1 - a1 * step
+                x0 = x1 - step * 0.5 * (v0 + v1)
+            v0s[r, j], x0s[r, j] = v0, x0
+            accs[r, j] = (v1 - v0) / step
+            gaps[r, j] = x1 - (x0 + step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
     X = np.empty((steps, q))
     V = np.empty((steps, q))
     A = np.empty((steps, q))
@@ -450,14 +465,7 @@ def _ballistic_between_frames(FX: np.ndarray, FV: np.ndarray, FA: np.ndarray, se
             if not seen[r + 1, j]:
                 X[k, j], V[k, j], A[k, j], present[k, j] = -1e6, 0.0, 0.0, False
                 continue
-            v1, a1, x1 = FV[r + 1, j], FA[r + 1, j], FX[r + 1, j]
-            if seen[r, j]:
-                v0, x0 = FV[r, j], FX[r, j]
-            else:  # first seen at frame r + 1: traced back along the same motion
-                v0 = v1 - a1 * step
-                x0 = x1 - step * 0.5 * (v0 + v1)
-            acc = (v1 - v0) / step
-            gap = x1 - (x0 + step * 0.5 * (v0 + v1))  # zero when the frames follow the ballistic rule
+            v0, x0, acc, gap = v0s[r, j], x0s[r, j], accs[r, j], gaps[r, j]
             X[k, j] = x0 + v0 * tau + 0.5 * acc * (tau * tau) + gap * tau / step
             V[k, j] = v0 + acc * tau + gap / step
             A[k, j] = acc

@@ -291,6 +291,11 @@ _OPEN_STAMP = b'"timestamp":{"sec":%s,"nsec":%s}'  # ... and left open for the s
 _R = "%r"  # a Python number filled in at every scene
 
 
+def _body(big: bool) -> tuple[float, float, float]:
+    """A drawn vehicle's width, height and wheel diameter, m: a truck's (``big``) or a car's."""
+    return (2.5, 3.0, 0.9) if big else (1.8, 1.4, 0.65)
+
+
 def _c(value: float) -> float:
     """A coordinate rounded to the drawing's centimetre (no "-0.0"), as :func:`_vec` writes it."""
     return round(float(value), _DECIMALS) + 0.0
@@ -492,8 +497,10 @@ class SceneWriter:
             heavy = {owner: len(cols) > 1 or max(getattr(report.models[j], "total_mass", 0.0) for j in cols) > HEAVY_KG
                      for owner, cols in groups.items()}
         datas: list[bytes] = []
-        for i, (t, k) in enumerate(zip(times, rows)):
-            cars = self._vehicles(t, report, k, groups, heavy, x[i], near[i], z[i]) if vehicles else []
+        seconds, nanoseconds = (ns // 1_000_000_000).tolist(), (ns % 1_000_000_000).tolist()
+        for i, k in enumerate(rows):
+            cars = self._vehicles((seconds[i], nanoseconds[i]), report, k, groups, heavy, x[i], near[i], z[i]) \
+                if vehicles else []
             datas.append(b",".join([scenes[i], *cars]) + b"]}")
         self.rec.write_encoded(TOPIC_SCENE, times, datas)
 
@@ -503,8 +510,7 @@ class SceneWriter:
         key = (big, axles, arrows)
         template = self._vehicle_templates.get(key)
         if template is None:
-            width, height = (2.5, 3.0) if big else (1.8, 1.4)
-            wheel = 0.9 if big else 0.65
+            width, height, wheel = _body(big)
             point = {"x": _R, "y": _R, "z": _R}
             box = {"pose": {"position": point, "orientation": _IDENTITY},
                    "size": {"x": _R, "y": _c(width), "z": _c(height)}, "color": _TRUCK if big else _CAR}
@@ -519,17 +525,16 @@ class SceneWriter:
             template = self._vehicle_templates[key] = _template(entity)
         return template
 
-    def _vehicles(self, t: float, report: Any, k: int, groups: dict[str, list[int]], heavy: dict[str, bool],
-                  x_all: np.ndarray, near: np.ndarray, z_all: np.ndarray) -> list[bytes]:
+    def _vehicles(self, stamp: tuple[int, int], report: Any, k: int, groups: dict[str, list[int]],
+                  heavy: dict[str, bool], x_all: np.ndarray, near: np.ndarray, z_all: np.ndarray) -> list[bytes]:
         """A box over each vehicle's axles, its wheels (axles) and its contact forces as arrows, at step ``k`` of
-        the block, as encoded entities. ``groups``: each vehicle's contact columns; ``x_all``, ``z_all``: the
-        contact points' x and drawn deck level, m; ``near``: on or near the deck."""
+        the block (time ``stamp``: s, ns), as encoded entities. ``groups``: each vehicle's contact columns;
+        ``x_all``, ``z_all``: the contact points' x and drawn deck level, m; ``near``: on or near the deck."""
         plan = self.plan
         y_all = report.y
         forces = report.contact_force[k]
         on_deck = report.on_deck[k]
-        stamp = _time(t)
-        sec, nsec = stamp["sec"], stamp["nsec"]
+        sec, nsec = stamp
         out = []
         for owner, cols in groups.items():
             cols = [j for j in cols if near[j]]
@@ -538,12 +543,11 @@ class SceneWriter:
             xs = [float(x_all[j]) for j in cols]
             zs = [float(z_all[j]) for j in cols]
             big = heavy[owner]
-            width, height = (2.5, 3.0) if big else (1.8, 1.4)
+            width, height, wheel = _body(big)
             overhang = 1.5 if len(cols) > 1 else (5.0 if big else 2.25)
             front, back = max(xs) + overhang, min(xs) - overhang
             y = sum(float(y_all[j]) for j in cols) / len(cols)
             z0 = sum(zs) / len(cols)
-            wheel = 0.9 if big else 0.65
             numbers: list[Any] = [sec, nsec, orjson.dumps(f"vehicle {owner}"),
                                   _c((front + back) / 2), _c(y), _c(z0 + wheel * 0.6 + height / 2), _c(front - back)]
             for x, z in zip(xs, zs):

@@ -157,7 +157,7 @@ class SumoProcess:
         self._table = state["table"]
         attach = getattr(self.frame_sink, "attach", None)
         if attach is not None:
-            attach(VEHICLE_TYPES_ATTACHMENT, self._table, "application/json")
+            self.log_documents(attach)
         self.frames = FrameTraffic(self.step, self.axis.length, self.models)
         return self
 

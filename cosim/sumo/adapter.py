@@ -147,7 +147,6 @@ class SumoTraffic:
         if not end > begin:
             raise ConfigError(f"traffic `end` ({end} s) must be after `begin` ({begin} s)")
         self.axis, self.step, self.begin, self.end = axis, float(step), float(begin), float(end)
-        self._deck_length = float(axis.length)
         self.seed = seed
         self.deck_y = (float(deck_y[0]), float(deck_y[1])) if deck_y is not None else (-half_width, half_width)
         self.half_width = max(abs(self.deck_y[0]), abs(self.deck_y[1]))
@@ -338,7 +337,7 @@ class SumoTraffic:
     @property
     def _x_range(self) -> tuple[float, float]:
         """Contact points farther along the axis than this from the deck are not followed, m."""
-        return (-self.reach, self._deck_length + self.reach)
+        return (-self.reach, self.axis.length + self.reach)
 
     def _extend_reach(self) -> None:
         """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
