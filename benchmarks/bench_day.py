@@ -51,42 +51,15 @@ RUNS = ("sumo", "direct", "direct+log", "direct+log/thread", "direct+log/no-scen
 DEFAULT_OUT = HERE / "results" / "day.md"
 
 WORKER = r"""
-import json, resource, sys, tempfile, time, tomllib
+import json, resource, sys, tempfile, time
 from pathlib import Path
-from cosim.run.scenario import load_scenario, parse_scenario
-from cosim.run.toml_writer import toml_dumps
 
 mode, hours = sys.argv[1], float(sys.argv[2])
+sys.path.insert(0, sys.argv[3])
+from _day import default_run
 duration = 3600.0 * hours
-base = load_scenario("paper-bridge-traffic")
-data = tomllib.loads(base.text)
-data["traffic"]["end"] = duration
-basis = mode.split("+")[0]
-if basis in ("direct", "modal"):
-    data["solver"]["basis"] = basis
-    if basis == "modal":
-        data["solver"]["modes"] = 30
-if mode.endswith("@1ms"):
-    data["solver"]["dt"] = 0.001
-if mode.endswith("/no-scene"):  # as a run longer than SCENE_MAX_DURATION (or one that says so) has it
-    data.setdefault("output", {})["scene"] = False
-scenario = parse_scenario(toml_dumps(data), f"bench-{mode}", base_dir=base.base_dir)
-bridge = scenario.build_bridge()
-# Compile (or load) the kernels outside the timed part.
-from cosim.core.sensors import Sensor
+scenario, bridge = default_run(mode, hours)  # kernels compiled, 20 s of the traffic run untimed
 from cosim.core.simulation import simulate
-from cosim.core.traffic import ScriptedTraffic
-simulate(bridge, ScriptedTraffic((), bridge.length), 0.05, scenario.solver_settings(), [Sensor("s", 1.0)])
-# ... and every compiled function of a SUMO run (projection, interpolation, road, extremes): 20 s of traffic.
-from cosim.run.simulate import build_traffic
-warm = tomllib.loads(toml_dumps(data))
-warm["traffic"]["end"] = 20.0
-warm = parse_scenario(toml_dumps(warm), "warm-up", base_dir=base.base_dir)
-# SUMO where the timed run has it: in a child without a log or without the scene (the parent's memory stays
-# the run's own).
-with build_traffic(warm, process=mode in ("direct", "modal") or mode.endswith("/no-scene")) as traffic:
-    simulate(bridge, traffic, 20.0, warm.solver_settings(), warm.sensors_core(), road=warm.build_road(),
-             output_every=warm.output_every, collect=False)
 out = {"log_bytes": 0}
 started = time.perf_counter()
 if mode == "sumo":
@@ -115,8 +88,8 @@ print(json.dumps(out))
 
 def run_one(mode: str, hours: float) -> dict:
     env = dict(os.environ)
-    out = subprocess.run([sys.executable, "-c", WORKER, mode, str(hours)], capture_output=True, text=True,
-                         check=False, env=env)
+    out = subprocess.run([sys.executable, "-c", WORKER, mode, str(hours), str(HERE)], capture_output=True,
+                         text=True, check=False, env=env)
     if out.returncode != 0:
         tail = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"exit {out.returncode}"
         return {"error": tail}

@@ -81,7 +81,7 @@ PARTS = {
 }
 
 WORKER = r"""
-import collections, json, sys, tempfile, threading, time, tomllib
+import collections, json, sys, tempfile, threading, time
 from pathlib import Path
 
 mode, hours, report_dir = sys.argv[1], float(sys.argv[2]), Path(sys.argv[3])
@@ -91,8 +91,7 @@ duration = 3600.0 * hours
 cpu = collections.Counter()
 calls = collections.Counter()
 
-active = threading.local()  # the keys being timed in this thread: a nested call of one (SumoProcess.block
-                            # calls FrameTraffic.block) is counted once
+active = threading.local()  # the keys being timed in this thread: a part called inside itself counts once
 
 def wrap(owner, name, key):
     original = getattr(owner, name)
@@ -114,21 +113,23 @@ import libsumo, zstandard
 import cosim.core.coupling, cosim.core.simulation, cosim.core.traffic, cosim.log.process, cosim.log.scene
 import cosim.log.writer, cosim.run.sumo_process, cosim.sumo.adapter
 from multiprocessing.connection import Connection
-wrap(libsumo, "simulationStep", "sumo.step")
-wrap(cosim.sumo.adapter.SumoTraffic, "advance", "sumo.advance")
-wrap(cosim.core.traffic.FrameTraffic, "block", "frames")
-wrap(cosim.run.sumo_process.SumoProcess, "block", "frames")
-wrap(cosim.log.process._BlockStream, "on_block", "handover")
-wrap(cosim.log.process._FrameSink, "__call__", "framesink")
-wrap(cosim.core.simulation._Extremes, "on_block", "extremes")
-wrap(cosim.core.coupling.CoupledSystem, "advance", "solver")
-wrap(cosim.log.scene.SceneWriter, "write_block", "scene")
-wrap(cosim.log.writer.BlockLogger, "_write_piece", "piece.all")
-wrap(cosim.log.writer.BlockLogger, "_vehicles", "vehicles")
-wrap(cosim.log.writer.BlockLogger, "_events", "events")
-wrap(cosim.log.writer.TrafficLogger, "write_frames", "traffic")
-wrap(zstandard, "compress", "zstd")
-wrap(Connection, "recv", "recv")
+for owner, name, key in (
+        (libsumo, "simulationStep", "sumo.step"),
+        (cosim.sumo.adapter.SumoTraffic, "advance", "sumo.advance"),
+        (cosim.core.traffic.FrameTraffic, "block", "frames"),
+        (cosim.run.sumo_process.SumoProcess, "block", "frames"),
+        (cosim.log.process._BlockStream, "on_block", "handover"),
+        (cosim.log.process._FrameSink, "__call__", "framesink"),
+        (cosim.core.simulation._Extremes, "on_block", "extremes"),
+        (cosim.core.coupling.CoupledSystem, "advance", "solver"),
+        (cosim.log.scene.SceneWriter, "write_block", "scene"),
+        (cosim.log.writer.BlockLogger, "_write_piece", "piece.all"),
+        (cosim.log.writer.BlockLogger, "_vehicles", "vehicles"),
+        (cosim.log.writer.BlockLogger, "_events", "events"),
+        (cosim.log.writer.TrafficLogger, "write_frames", "traffic"),
+        (zstandard, "compress", "zstd"),
+        (Connection, "recv", "recv")):
+    wrap(owner, name, key)
 
 def child_report(name, serve):
     def served(*args):
@@ -158,37 +159,16 @@ def null_serve(commands, replies, path, names, scene):
 cosim.log.process._serve = child_report("cosim-log-writer", cosim.log.process._serve)
 cosim.run.sumo_process._serve = child_report("cosim-sumo", cosim.run.sumo_process._serve)
 
-from cosim.run.scenario import load_scenario, parse_scenario
-from cosim.run.toml_writer import toml_dumps
-base = load_scenario("paper-bridge-traffic")
-data = tomllib.loads(base.text)
-data["traffic"]["end"] = duration
-basis = mode.split("+")[0]
-if basis in ("direct", "modal"):
-    data["solver"]["basis"] = basis
-    if basis == "modal":
-        data["solver"]["modes"] = 30
-if mode.endswith("/no-scene"):
-    data.setdefault("output", {})["scene"] = False
-scenario = parse_scenario(toml_dumps(data), f"profile-{mode}", base_dir=base.base_dir)
-bridge = scenario.build_bridge()
-from cosim.core.sensors import Sensor
-from cosim.core.simulation import simulate
-from cosim.core.traffic import ScriptedTraffic
-simulate(bridge, ScriptedTraffic((), bridge.length), 0.05, scenario.solver_settings(), [Sensor("s", 1.0)])
+sys.path.insert(0, sys.argv[4])
+from _day import default_run
+scenario, bridge = default_run(mode, hours)  # kernels compiled, 20 s of the traffic run untimed
 from cosim.run.simulate import build_traffic
-warm = tomllib.loads(toml_dumps(data))
-warm["traffic"]["end"] = 20.0
-warm = parse_scenario(toml_dumps(warm), "warm-up", base_dir=base.base_dir)
-with build_traffic(warm, process=mode.endswith("/no-scene")) as traffic:
-    simulate(bridge, traffic, 20.0, warm.solver_settings(), warm.sensors_core(), road=warm.build_road(),
-             output_every=warm.output_every, collect=False)
 for path in report_dir.glob("*.json"):
     path.unlink()
 cpu.clear()
 calls.clear()
 out = {"mode": sys.argv[1]}
-started, main0, process0 = time.perf_counter(), time.thread_time(), time.process_time()
+started, process0 = time.perf_counter(), time.process_time()
 if mode == "sumo":
     with build_traffic(scenario, process=False) as traffic:
         for _ in range(int(round(duration / scenario.traffic.step))):
@@ -199,7 +179,6 @@ else:
     outcome = run_logged(scenario, path, bridge=bridge)
     out["log_bytes"] = outcome.log_bytes
 out["wall"] = time.perf_counter() - started
-out["main"] = time.thread_time() - main0
 out["process"] = time.process_time() - process0
 out["run"] = dict(cpu, calls=sum(calls.values()))
 out["children"] = {p.stem: json.loads(p.read_text()) for p in report_dir.glob("*.json")}
@@ -208,8 +187,8 @@ print(json.dumps(out))
 
 
 def run_one(mode: str, hours: float, report_dir: Path) -> dict:
-    out = subprocess.run([sys.executable, "-c", WORKER, mode, str(hours), str(report_dir)], capture_output=True,
-                         text=True, check=False, env=dict(os.environ))
+    out = subprocess.run([sys.executable, "-c", WORKER, mode, str(hours), str(report_dir), str(HERE)],
+                         capture_output=True, text=True, check=False, env=dict(os.environ))
     if out.returncode != 0:
         tail = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"exit {out.returncode}"
         return {"mode": mode, "error": tail}
