@@ -37,6 +37,7 @@ import os
 import platform
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -50,7 +51,7 @@ RUNS = ("sumo", "direct+log", "direct+log+null", "modal+log", "modal+log+null", 
         "direct+log/no-scene+null", "modal+log/no-scene", "modal+log/no-scene+null")
 DEFAULT_OUT = HERE / "results" / "profile.md"
 
-# The parts, by process: (key, what the report calls it). "of which" parts are inside the part above them.
+# The parts, by process: (key, what the report calls it). zstd is inside the writer's parts above it.
 PARTS = {
     "run": [
         ("sumo.step", "SUMO's steps (`libsumo.simulationStep`)"),
@@ -60,13 +61,13 @@ PARTS = {
         ("framesink", "hand-over of SUMO frames to the log writer (`_FrameSink`)"),
         ("recv", "receiving SUMO's frames from its process (`Connection.recv`)"),
         ("extremes", "running extremes (`_Extremes.on_block`)"),
-        ("main.rest", "the rest of the run's process (block loop, observers, progress)"),
+        ("main.rest", "the rest of the run's process (start-up, block loop, observers, progress)"),
         ("solver", "solver thread: `CoupledSystem.advance` (compiled step and its Python)"),
     ],
     "cosim-sumo": [
         ("sumo.step", "SUMO's steps (`libsumo.simulationStep`)"),
         ("sumo.adapter", "the adapter (`SumoTraffic.advance` less the steps)"),
-        ("sumo.rest", "packing frames, the pipe"),
+        ("sumo.rest", "SUMO's start, packing frames, the pipe"),
     ],
     "cosim-log-writer": [
         ("recv", "receiving and unpickling blocks and frames"),
@@ -270,13 +271,12 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     runs = ["sumo", *[r for r in RUNS if r != "sumo" and (not args.only or r in args.only)]]
     started = datetime.datetime.now()
-    report_dir = Path(os.environ.get("TMPDIR", "/tmp")) / f"cosim-profile-{os.getpid()}"
-    report_dir.mkdir(parents=True, exist_ok=True)
     results = []
-    for mode in runs:
-        r = run_one(mode, args.hours, report_dir)
-        print(json.dumps(r), flush=True)
-        results.append(r)
+    with tempfile.TemporaryDirectory(prefix="cosim-profile-") as report_dir:  # the children's parts
+        for mode in runs:
+            r = run_one(mode, args.hours, Path(report_dir))
+            print(json.dumps(r), flush=True)
+            results.append(r)
     sumo = next((r["wall"] for r in results if r["mode"] == "sumo" and "wall" in r), None)
     lines = [
         f"# Where a logged run's time goes: {args.hours:g} simulated hour(s) of the default run",
