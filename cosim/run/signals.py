@@ -52,14 +52,17 @@ class StopGuard:
     Attributes:
         closing: from now on signals are held back (recorded, not raised).
         held: the first signal held back while closing, raised when the block ends normally.
+        received: how many signals arrived within the block (raised or held).
     """
 
-    def __init__(self) -> None:
-        self.closing = False
+    def __init__(self, closing: bool = False) -> None:
+        self.closing = closing
         self.held: Interrupted | None = None
+        self.received = 0
         self._old: dict[int, Any] = {}
 
     def _handle(self, signum: int, frame: object) -> None:
+        self.received += 1
         if self.closing:
             if self.held is None:
                 self.held = Interrupted(signum, signal.Signals(signum).name)
@@ -69,14 +72,18 @@ class StopGuard:
 
 
 @contextlib.contextmanager
-def stop_signals() -> Iterator[StopGuard]:
+def stop_signals(hold: bool = False) -> Iterator[StopGuard]:
     """Within the block, SIGINT, SIGTERM and SIGHUP raise :class:`Interrupted` once; then they are held back.
 
     A signal held back while the block was closing (``guard.closing``) is
     raised when the block ends without an exception of its own, so it is
     never lost: the caller sees the interruption after the log is finished.
+
+    With ``hold``, every signal is held back from the start: the block polls
+    ``guard.held`` and raises it where it is safe to (a ``KeyboardInterrupt``
+    inside a Dask client call leaves its event loop printing a traceback).
     """
-    guard = StopGuard()
+    guard = StopGuard(closing=hold)
     if threading.current_thread() is threading.main_thread():
         for signum in STOP_SIGNALS:
             old = signal.getsignal(signum)

@@ -27,6 +27,7 @@ from typing import Any
 from cosim.errors import ConfigError, CosimError, Interrupted, interruption
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
+from cosim.run.signals import StopGuard, stop_signals
 from cosim.study.characteristic import write_characteristic
 from cosim.study.folder import (
     LOG_FILE,
@@ -60,6 +61,8 @@ WORKER_WAIT = 60.0
 STOP_CHECK_EVERY = 0.5
 #: How long a stopped study waits for the runs in progress to finish their logs, s.
 STOP_WAIT = 30.0
+#: How often the study's main thread looks for finished runs and held signals while runs are on Dask, s.
+POLL = 0.05
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -368,38 +371,47 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
         if cluster is not None:
             cluster.close()
         raise
-    try:
-        n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) if scheduler else \
-            len(cluster.workers)  # type: ignore[union-attr]
-        by_key: dict[str, RunTask] = {}
-        futures = []
-        for task in todo:
-            key = f"cosim-run-{study.name}-{task.run_id}-{task.fingerprint[:12]}"
-            future = client.submit(execute_run, task, key=key, pure=False, retries=0)
-            by_key[str(future.key)] = task
-            futures.append(future)
+    # From here on a signal is held and polled, never raised inside a Dask call: a KeyboardInterrupt
+    # within distributed's sync() makes its event loop log a NameError traceback (distributed 2026.8).
+    futures: list[Any] = []
+    with stop_signals(hold=True) as guard:
         try:
-            for future in as_completed(futures):
-                task = by_key[future.key]
-                try:
-                    row = future.result()
-                except Exception as exc:  # noqa: BLE001 - e.g. the worker died (KilledWorker)
-                    row = _lost_row(task, exc)
-                finished(row)
-        except KeyboardInterrupt as exc:
-            _stop_runs(client, futures, by_key, study.output / STOP_FILE, interruption(exc)[1], finished)
+            n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) if scheduler else \
+                len(cluster.workers)  # type: ignore[union-attr]
+            by_key: dict[str, RunTask] = {}
+            for task in todo:
+                key = f"cosim-run-{study.name}-{task.run_id}-{task.fingerprint[:12]}"
+                future = client.submit(execute_run, task, key=key, pure=False, retries=0)
+                by_key[str(future.key)] = task
+                futures.append(future)
+            pending = as_completed(futures)
+            while not pending.is_empty():
+                if guard.held is not None:
+                    _stop_runs(client, futures, by_key, study.output / STOP_FILE, guard, finished)
+                    raise guard.held
+                batch = pending.next_batch(block=False)
+                if not batch:
+                    time.sleep(POLL)
+                for future in batch:
+                    task = by_key[future.key]
+                    try:
+                        row = future.result()
+                    except Exception as exc:  # noqa: BLE001 - e.g. the worker died (KilledWorker)
+                        row = _lost_row(task, exc)
+                    finished(row)
+        except Interrupted:
             raise
         except BaseException:
             client.cancel(futures)
             raise
-        return n_workers
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return n_workers
 
 
-def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop: Path, name: str,
+def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop: Path, guard: StopGuard,
                finished: Callable[[dict[str, Any]], None]) -> None:
     """Stop a study on Dask: runs not yet begun are cancelled, runs in progress stop with finished logs.
 
@@ -409,10 +421,8 @@ def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop
     Runs that completed meanwhile are handed to ``finished``. A second signal
     while waiting stops the waiting.
     """
-    from dask.distributed import wait
-
     try:
-        stop.write_text(name, encoding="utf-8")
+        stop.write_text(guard.held.name if guard.held else "SIGTERM", encoding="utf-8")
     except OSError:
         client.cancel(futures)
         return
@@ -423,7 +433,9 @@ def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop
             assigned = set()
         client.cancel([f for f in futures if str(f.key) not in assigned and not f.done()])
         running = [f for f in futures if str(f.key) in assigned]
-        wait(running, timeout=STOP_WAIT)
+        deadline = time.monotonic() + STOP_WAIT
+        while guard.received < 2 and time.monotonic() < deadline and not all(f.done() for f in running):
+            time.sleep(POLL)
         for future in running:
             if future.done() and future.status == "finished":
                 row = future.result()
