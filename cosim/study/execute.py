@@ -348,34 +348,39 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
     """Submit the runs to a Dask cluster and hand every row to ``finished`` as it arrives; returns the workers."""
     from dask.distributed import Client, LocalCluster, as_completed
 
+    # Signals are held and polled, never raised inside a Dask call: a KeyboardInterrupt within
+    # distributed's sync() makes its event loop log a NameError traceback (distributed 2026.8). Only
+    # connecting to a remote scheduler (up to 80 s) stays interruptible at once.
     cluster = None
-    try:
-        if scheduler is not None:
-            try:
-                client = Client(scheduler, timeout="20s")
-            except (OSError, TimeoutError) as exc:
-                raise CosimError(f"--scheduler {scheduler}: cannot connect to the Dask scheduler ({exc})") from None
-            try:
-                client.wait_for_workers(1, timeout=WORKER_WAIT)
-            except TimeoutError:
-                client.close()
-                raise CosimError(f"--scheduler {scheduler}: the scheduler has no workers (waited {WORKER_WAIT:g} s; "
-                                 "start some with: dask worker ADDRESS --nthreads 1)") from None
-        else:
-            n = min(workers or default_workers(), len(todo))
-            with _terminal_signals_ignored():  # the worker processes start with these ignored
-                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                                       silence_logs=logging.ERROR)
-            client = Client(cluster)
-    except BaseException:
-        if cluster is not None:
-            cluster.close()
-        raise
-    # From here on a signal is held and polled, never raised inside a Dask call: a KeyboardInterrupt
-    # within distributed's sync() makes its event loop log a NameError traceback (distributed 2026.8).
     futures: list[Any] = []
-    with stop_signals(hold=True) as guard:
+    with stop_signals(hold=scheduler is None) as guard:
         try:
+            if scheduler is not None:
+                try:
+                    client = Client(scheduler, timeout="20s")
+                except (OSError, TimeoutError) as exc:
+                    raise CosimError(f"--scheduler {scheduler}: cannot connect to the Dask scheduler ({exc})") \
+                        from None
+                try:
+                    client.wait_for_workers(1, timeout=WORKER_WAIT)
+                except TimeoutError:
+                    client.close()
+                    raise CosimError(f"--scheduler {scheduler}: the scheduler has no workers (waited "
+                                     f"{WORKER_WAIT:g} s; start some with: dask worker ADDRESS --nthreads 1)") from None
+                guard.closing = True  # connected: hold signals from here on
+            else:
+                n = min(workers or default_workers(), len(todo))
+                with _terminal_signals_ignored():  # the worker processes start with these ignored
+                    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=logging.ERROR)
+                client = Client(cluster)
+        except BaseException:
+            if cluster is not None:
+                cluster.close()
+            raise
+        try:
+            if guard.held is not None:  # a signal while the cluster started: nothing submitted yet
+                raise guard.held
             n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) if scheduler else \
                 len(cluster.workers)  # type: ignore[union-attr]
             by_key: dict[str, RunTask] = {}
