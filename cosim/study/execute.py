@@ -279,7 +279,8 @@ def run_study(
         The rows, what ran and what was reused, and the files written.
 
     Raises:
-        KeyboardInterrupt: Ctrl-C; the table of the runs finished so far is written first.
+        KeyboardInterrupt: Ctrl-C, or SIGTERM/SIGHUP while runs are in progress (then an
+            :class:`Interrupted` naming the signal); the table of the runs finished so far is written first.
         CosimError: the output folder cannot be written, or the scheduler cannot be reached.
     """
     started = time.perf_counter()
