@@ -393,7 +393,7 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
             pending = as_completed(futures)
             while not pending.is_empty():
                 if guard.held is not None:
-                    _stop_runs(client, futures, by_key, study.output / STOP_FILE, guard, finished)
+                    _stop_runs(client, futures, study.output / STOP_FILE, guard, finished)
                     raise guard.held
                 batch = pending.next_batch(block=False)
                 if not batch:
@@ -417,7 +417,7 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
     return n_workers
 
 
-def _stop_runs(client: Any, futures: list[Any], by_key: dict[str, RunTask], stop: Path, guard: StopGuard,
+def _stop_runs(client: Any, futures: list[Any], stop: Path, guard: StopGuard,
                finished: Callable[[dict[str, Any]], None]) -> None:
     """Stop a study on Dask: runs not yet begun are cancelled, runs in progress stop with finished logs.
 

@@ -19,7 +19,10 @@ import pandas as pd
 import pytest
 from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, cli_env, sumo_folder, write
 
+from cosim.errors import Interrupted
 from cosim.log import LogRecorder, open_log
+from cosim.run.signals import stop_signals
+from cosim.study.execute import _stop_runs
 
 # One slow car for 10 000 s, every step logged: a run long enough to be stopped from outside.
 LONG = (PROFILED.replace('name = "profiled"', 'name = "long"').replace("speed = 25.0", "speed = 0.05")
@@ -206,3 +209,42 @@ def test_a_stopped_study_writes_the_table_of_its_completed_runs(tmp_path: Path, 
     for overview in stopped:
         assert overview.complete and overview.final_status["state"] == "interrupted", overview.final_status
     assert not (tmp_path / "out" / ".stop").exists()
+
+
+def _a_run_that_stops_when_told(stop: Path, release: Path) -> dict[str, str]:
+    """Stands in for a study's run on a worker: it stops once the stop file appears (as runs do) and, for
+    a run that does not stop in time, the file ``release`` too (made by the test, at most 60 s)."""
+    deadline = time.monotonic() + 60.0
+    while not (stop.exists() and release.exists()) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return {"run_id": "a", "status": "ok"}
+
+
+@pytest.mark.parametrize("signals", [1, 2])
+def test_a_second_signal_stops_the_wait_for_the_runs_in_progress(tmp_path: Path, signals: int) -> None:
+    """A study stopped on Dask (real signals to this process, a real in-process cluster): with one signal it
+    waits for the run in progress and keeps its row; a second signal ends the wait at once, leaving none."""
+    from dask.distributed import Client, LocalCluster
+
+    stop, release, rows = tmp_path / ".stop", tmp_path / "release", []
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        future = client.submit(_a_run_that_stops_when_told, stop, release, key="cosim-run-a", pure=False)
+        wait_for(lambda: any(client.processing().values()), 30)
+        if signals == 1:
+            release.touch()  # the run stops as soon as it sees the stop file
+        started = time.monotonic()
+        with pytest.raises(Interrupted) as held, stop_signals(hold=True) as guard:
+            for _ in range(signals):
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.01)
+            _stop_runs(client, [future], stop, guard, rows.append)
+        waited = time.monotonic() - started
+        assert not stop.exists()  # removed on the way out, for the next run of the same study
+        release.touch()
+        stop.touch()  # lets the run end so that the cluster closes at once
+    assert held.value.name == "SIGINT" and guard.received == signals
+    if signals == 1:
+        assert rows == [{"run_id": "a", "status": "ok"}]
+    else:
+        assert rows == [] and waited < 5.0  # STOP_WAIT is 30 s; the run would have held it to 60 s
