@@ -13,6 +13,17 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "integration"))
 
 from _cli import TWO_CARS, cli_env, cosim_cli, cosim_process  # noqa: E402, F401 - shared with the tests here
 
+
+def assert_one_line(result, status: int, *fragments: str) -> str:  # noqa: ANN001 - CliResult
+    """Assert that a command failed with exit ``status`` and one line ``cosim: error: ...`` on stderr holding
+    every fragment, with no traceback; returns the line."""
+    assert result.returncode == status, (result.stdout, result.stderr)
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cosim: error: ") and "Traceback" not in result.stderr, lines
+    for fragment in fragments:
+        assert fragment in lines[0], (fragment, lines[0])
+    return lines[0]
+
 #: TWO_CARS with a measured road profile next to it (an input file its log embeds), 4 s simulated.
 PROFILED = TWO_CARS.replace('name = "two-cars"', 'name = "profiled"').replace(
     '[road]\nclass = "H"\nseed = 7', '[road]\nprofile = "data/road.csv"')

@@ -8,20 +8,11 @@ from pathlib import Path
 
 import pytest
 from _craft import rewrite
-from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, cosim_cli, sumo_folder, write
+from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, assert_one_line, cosim_cli, sumo_folder, write
 
 from cosim.log import TOPIC_SENSORS, TOPIC_TRAFFIC, TOPIC_VEHICLES, open_log
 
 DAMPING = '[bridge.damping]\nratios = [0.02, 0.02]\nmodes = ["vertical-1", "torsion-1"]\n'
-
-
-def one_line(result, status: int, *fragments: str) -> str:  # noqa: ANN001 - CliResult
-    assert result.returncode == status, (result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("cosim: error: ") and "Traceback" not in result.stderr, lines
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    return lines[0]
 
 
 def profiled(folder: Path, road: str = ROAD_CSV, **replace: str) -> Path:
@@ -46,30 +37,30 @@ def test_a_diverging_run_names_its_likely_cause_and_finishes_its_log(tmp_path: P
     else:
         scenario = profiled(tmp_path, **{"m_v = 1000.0": "m_v = 1e300"})
     result = cosim_cli("run", str(scenario), "--out", "o.mcap", "--quiet", cwd=tmp_path)
-    one_line(result, 1, "the solution diverged", cause, 'its log o.mcap is finished, status "error"')
+    assert_one_line(result, 1, "the solution diverged", cause, 'its log o.mcap is finished, status "error"')
     status = open_log(tmp_path / "o.mcap").final_status
     assert status["state"] == "error" and cause in status["message"]
 
 
-def test_a_mass_density_of_1e_minus_300_is_one_line(tmp_path: Path) -> None:
+def test_a_mass_density_of_1e_minus_300_is_assert_one_line(tmp_path: Path) -> None:
     scenario = profiled(tmp_path, **{"rho = 2500": "rho = 1e-300"})
-    one_line(cosim_cli("modes", str(scenario), cwd=tmp_path), 2, "the modal analysis found 0 of",
-             "rho = 1e-300 kg/m^3")
+    assert_one_line(cosim_cli("modes", str(scenario), cwd=tmp_path), 2, "the modal analysis found 0 of",
+                    "rho = 1e-300 kg/m^3")
     modal = profiled(tmp_path, **{"rho = 2500": "rho = 1e-300", DAMPING: "",
                                   "dt = 0.002": 'dt = 0.002\nbasis = "modal"'})
-    one_line(cosim_cli("run", str(modal), "--out", "o.mcap", cwd=tmp_path), 2, "the modal analysis found 0 of")
+    assert_one_line(cosim_cli("run", str(modal), "--out", "o.mcap", cwd=tmp_path), 2, "the modal analysis found 0 of")
     assert not (tmp_path / "o.mcap").exists()
 
 
-def test_an_output_folder_that_cannot_be_written_is_one_line(profiled_log: Path, tmp_path: Path) -> None:
+def test_an_output_folder_that_cannot_be_written_is_assert_one_line(profiled_log: Path, tmp_path: Path) -> None:
     folder = Path("/sys/kernel")  # no file can be created there, not even by root
     scenario = profiled(tmp_path)
-    one_line(cosim_cli("run", str(scenario), "--out", str(folder / "o.mcap"), cwd=tmp_path), 2,
-             f"{folder / 'o.mcap'}: cannot create the log")
-    one_line(cosim_cli("export", str(profiled_log), "--csv", str(folder / "o.csv"), cwd=tmp_path), 2,
-             f"{folder / 'o.csv'}: cannot write the CSV")
-    one_line(cosim_cli("plot", str(profiled_log), "-o", str(folder / "o.png"), cwd=tmp_path), 2,
-             f"{folder / 'o.png'}: cannot write the plot")
+    assert_one_line(cosim_cli("run", str(scenario), "--out", str(folder / "o.mcap"), cwd=tmp_path), 2,
+                    f"{folder / 'o.mcap'}: cannot create the log")
+    assert_one_line(cosim_cli("export", str(profiled_log), "--csv", str(folder / "o.csv"), cwd=tmp_path), 2,
+                    f"{folder / 'o.csv'}: cannot write the CSV")
+    assert_one_line(cosim_cli("plot", str(profiled_log), "-o", str(folder / "o.png"), cwd=tmp_path), 2,
+                    f"{folder / 'o.png'}: cannot write the plot")
 
 
 def _spoil(topic_wanted: str, change):  # noqa: ANN001, ANN202
@@ -91,19 +82,19 @@ def test_crafted_message_contents_are_one_line_for_every_reader(profiled_log: Pa
                       message=_spoil(TOPIC_SENSORS, lambda m: {**m, "mid": "0.001"}))
     for args in (("export", str(sensors), "--csv", "o.csv"), ("plot", str(sensors), "-o", "o.png"),
                  ("replay", str(sensors), "--out", "r.mcap")):
-        one_line(cosim_cli(*args, cwd=tmp_path), 2, "a message on /cosim/sensors", "does not match its schema",
-                 "mid: expected a finite number, got '0.001'")
+        assert_one_line(cosim_cli(*args, cwd=tmp_path), 2, "a message on /cosim/sensors", "does not match its schema",
+                        "mid: expected a finite number, got '0.001'")
     vehicles = rewrite(profiled_log, tmp_path / "vehicles.mcap",
                        message=_spoil(TOPIC_VEHICLES, lambda m: {**m, "vehicles": 5}))
-    one_line(cosim_cli("export", str(vehicles), "--topic", TOPIC_VEHICLES, "--csv", "v.csv", cwd=tmp_path), 2,
-             "vehicles: expected an array, got 5")
+    assert_one_line(cosim_cli("export", str(vehicles), "--topic", TOPIC_VEHICLES, "--csv", "v.csv", cwd=tmp_path), 2,
+                    "vehicles: expected an array, got 5")
     frames = rewrite(sumo_log, tmp_path / "frames.mcap", message=_spoil(TOPIC_TRAFFIC, lambda m: {**m, "x": ["a"]}))
-    one_line(cosim_cli("replay", str(frames), "--out", "r.mcap", cwd=tmp_path), 2, "a message on /cosim/traffic",
-             "x[0]: expected a finite number")
+    assert_one_line(cosim_cli("replay", str(frames), "--out", "r.mcap", cwd=tmp_path), 2, "a message on /cosim/traffic",
+                    "x[0]: expected a finite number")
     short = rewrite(sumo_log, tmp_path / "short.mcap", message=_spoil(TOPIC_TRAFFIC, lambda m: {**m, "x": []}))
-    one_line(cosim_cli("replay", str(short), "--out", "r.mcap", "--quiet", cwd=tmp_path), 2, "ids but 0 x")
+    assert_one_line(cosim_cli("replay", str(short), "--out", "r.mcap", "--quiet", cwd=tmp_path), 2, "ids but 0 x")
     meta = rewrite(profiled_log, tmp_path / "meta.mcap", metadata={"cosim": {"rate_hz": "fast", "sensors": "[1]"}})
-    one_line(cosim_cli("info", str(meta), cwd=tmp_path), 2, "malformed cosim metadata: rate_hz")
+    assert_one_line(cosim_cli("info", str(meta), cwd=tmp_path), 2, "malformed cosim metadata: rate_hz")
     assert not any((tmp_path / n).exists() for n in ("o.csv", "o.png", "r.mcap", "v.csv", "runs"))
 
 
@@ -133,17 +124,18 @@ def test_sumo_start_up_errors_write_nothing(tmp_path: Path, case: str) -> None:
     scenario = write(tmp_path, "s.toml", text)
     for _ in range(2):  # and again: the same --out is not refused, since nothing was written
         result = cosim_cli("run", str(scenario), "--out", "o.mcap", "--quiet", cwd=tmp_path)
-        line = one_line(result, 2, fragment)
+        line = assert_one_line(result, 2, fragment)
         assert "already exists" not in line and "Error:" not in result.stderr.replace("cosim: error:", "")
         assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml", "sumo"]
 
 
 def test_a_basis_that_cannot_be_built_writes_nothing(tmp_path: Path) -> None:
     scenario = profiled(tmp_path, **{"dt = 0.002": 'dt = 0.002\nbasis = "modal"\ncutoff_hz = 1e-6'})
-    one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2, "solver.cutoff_hz: no mode below")
+    assert_one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2,
+                    "solver.cutoff_hz: no mode below")
     scenario = profiled(tmp_path, **{"elements_per_span = 8": "elements_per_span = 900", DAMPING: ""})
-    one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2,
-             "solver.basis: the direct basis keeps a dense", 'above 6000 free DOFs use basis = "modal"')
+    assert_one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2,
+                    "solver.basis: the direct basis keeps a dense", 'above 6000 free DOFs use basis = "modal"')
     assert not (tmp_path / "o.mcap").exists()
 
 
@@ -156,13 +148,13 @@ def test_a_study_refuses_the_folder_of_another_study(tmp_path: Path) -> None:
     other = write(tmp_path, "out/study.toml", '[study]\nname = "volumes"\nbase = "base.toml"\n')
     write(tmp_path, "out/results.csv", "run_id,status\nx,ok\n")
     mine = write(tmp_path, "mine.toml", '[study]\nname = "mine"\nbase = "base.toml"\nduration = 10.0\n')
-    one_line(cosim_cli("study", str(mine), "--out", "out", "--workers", "0", cwd=tmp_path), 2,
-             "holds the results of study 'volumes', not 'mine'", "give another --out")
+    assert_one_line(cosim_cli("study", str(mine), "--out", "out", "--workers", "0", cwd=tmp_path), 2,
+                    "holds the results of study 'volumes', not 'mine'", "give another --out")
     assert other.read_text().startswith('[study]\nname = "volumes"')
     assert (tmp_path / "out/results.csv").read_text() == "run_id,status\nx,ok\n"
     write(tmp_path, "out2/study.json", json.dumps({"name": "volumes", "source": "/elsewhere/volumes.toml"}))
-    one_line(cosim_cli("study", str(mine), "--out", "out2", "--workers", "0", cwd=tmp_path), 2,
-             "holds the results of study 'volumes'")
+    assert_one_line(cosim_cli("study", str(mine), "--out", "out2", "--workers", "0", cwd=tmp_path), 2,
+                    "holds the results of study 'volumes'")
 
 
 # --------------------------------------------------------------------------- item 9: nothing silently accepted
@@ -180,7 +172,7 @@ def test_misspelled_and_unused_vtype_params_are_errors(tmp_path: Path, old: str,
     assert old in text
     (folder / "vtypes.add.xml").write_text(text.replace(old, new, 1))
     scenario = write(tmp_path, "s.toml", SUMO_SCENARIO.format(end=20.0))
-    one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2, "vtypes.add.xml", fragment)
+    assert_one_line(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), 2, "vtypes.add.xml", fragment)
     assert not (tmp_path / "o.mcap").exists()
 
 
@@ -191,10 +183,10 @@ def test_misspelled_and_unused_vtype_params_are_errors(tmp_path: Path, old: str,
 ])
 def test_a_road_profile_is_read_strictly(tmp_path: Path, content: str, fragment: str) -> None:
     scenario = profiled(tmp_path, content)
-    one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", fragment)
+    assert_one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", fragment)
 
 
 def test_a_binary_road_profile_is_reported_at_its_key(tmp_path: Path) -> None:
     scenario = profiled(tmp_path)
     (tmp_path / "data/road.csv").write_bytes(bytes(range(256)) * 4)
-    one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", "not a text file")
+    assert_one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", "not a text file")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 from _craft import bomb, rewrite
-from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, cli_env, cosim_cli, sumo_folder, write
+from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, assert_one_line, cli_env, cosim_cli, sumo_folder, write
 
 from cosim.core.limits import MAX_CHUNK_BYTES, MAX_DOFS
 from cosim.errors import ConfigError
@@ -37,21 +37,18 @@ thickness = 0.4
 """
 
 
-def limit_error(result, *fragments: str) -> str:  # noqa: ANN001 - CliResult
-    assert result.returncode == 2, (result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in result.stderr, lines
-    assert "is more than the limit of" in lines[0] and "raise it with the environment variable COSIM_MAX_" in lines[0]
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    return lines[0]
+def assert_limit_error(result, *fragments: str) -> str:  # noqa: ANN001 - CliResult
+    """Assert that a command was refused (exit 2, one line) for a bounded input, naming the environment
+    variable that raises the bound; returns the line."""
+    return assert_one_line(result, 2, "is more than the limit of",
+                           "raise it with the environment variable COSIM_MAX_", *fragments)
 
 
 def test_elements_per_span_is_bounded_before_the_model_is_assembled(tmp_path: Path) -> None:
     write(tmp_path, "data/road.csv", ROAD_CSV)
     scenario = write(tmp_path, "huge.toml", PROFILED.replace("elements_per_span = 8", "elements_per_span = 100000000"))
-    line = limit_error(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path),
-                       "huge.toml: bridge: `elements_per_span`", "700,000,007 DOFs", "COSIM_MAX_DOFS")
+    line = assert_limit_error(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path),
+                              "huge.toml: bridge: `elements_per_span`", "700,000,007 DOFs", "COSIM_MAX_DOFS")
     assert "100,000,000 elements" in line and not (tmp_path / "o.mcap").exists()
 
 
@@ -68,8 +65,8 @@ def test_a_limit_is_raised_with_its_environment_variable(monkeypatch: pytest.Mon
 
 def test_a_fine_section_mesh_is_bounded_before_meshing(tmp_path: Path) -> None:
     scenario = write(tmp_path, "plates.toml", PAPER_PLATES.format(mesh=1e-5))
-    limit_error(cosim_cli("modes", str(scenario), cwd=tmp_path), "plates.toml: bridge.section: `mesh_size`",
-                "COSIM_MAX_SECTION_TRIANGLES")
+    assert_limit_error(cosim_cli("modes", str(scenario), cwd=tmp_path), "plates.toml: bridge.section: `mesh_size`",
+                       "COSIM_MAX_SECTION_TRIANGLES")
 
 
 def test_a_study_of_a_hundred_million_seeds_is_refused_at_once(tmp_path: Path) -> None:
@@ -82,14 +79,14 @@ def test_a_study_of_a_hundred_million_seeds_is_refused_at_once(tmp_path: Path) -
     assert "COSIM_MAX_RUNS" in result.stderr and not (tmp_path / "studies").exists()
     study = write(tmp_path, "s.toml", '[study]\nbase = "base.toml"\n[sweep]\nseeds = 200\n'
                                       'vehicles_per_hour = [' + ", ".join(str(100.0 + i) for i in range(60)) + "]\n")
-    limit_error(cosim_cli("study", str(study), "--workers", "0", cwd=tmp_path), "s.toml: sweep", "12,000 runs",
-                "COSIM_MAX_RUNS")
+    assert_limit_error(cosim_cli("study", str(study), "--workers", "0", cwd=tmp_path), "s.toml: sweep", "12,000 runs",
+                       "COSIM_MAX_RUNS")
 
 
 def test_a_road_profile_with_a_tiny_spacing_is_refused(tmp_path: Path) -> None:
     write(tmp_path, "data/road.csv", "x,r\n-1.0,0.0\n-0.999999999999,0.0\n21.0,0.001\n")
     scenario = write(tmp_path, "s.toml", PROFILED)
-    limit_error(cosim_cli("run", str(scenario), cwd=tmp_path), "s.toml: road.profile:", "COSIM_MAX_ROAD_POINTS")
+    assert_limit_error(cosim_cli("run", str(scenario), cwd=tmp_path), "s.toml: road.profile:", "COSIM_MAX_ROAD_POINTS")
 
 
 def test_an_iso_road_on_a_very_long_bridge_is_refused_before_the_grid(tmp_path: Path) -> None:
@@ -97,15 +94,16 @@ def test_an_iso_road_on_a_very_long_bridge_is_refused_before_the_grid(tmp_path: 
     scenario = write(tmp_path, "long.toml", undamped.replace("spans = [20.0]", "spans = [1e6]") + (
         '[[vehicles]]\nmodel = "moving-force"\nmass = 1000.0\ny = 0.0\nspeed = 10.0\n'
         '[road]\nclass = "A"\nseed = 1\n[solver]\nduration = 1.0\n'))
-    limit_error(cosim_cli("run", str(scenario), cwd=tmp_path), "long.toml: road: `class`", "COSIM_MAX_ROAD_POINTS")
+    assert_limit_error(cosim_cli("run", str(scenario), cwd=tmp_path), "long.toml: road: `class`",
+                       "COSIM_MAX_ROAD_POINTS")
 
 
 def test_a_run_of_too_many_steps_is_refused_before_its_log(tmp_path: Path) -> None:
     write(tmp_path, "data/road.csv", ROAD_CSV)
     scenario = write(tmp_path, "s.toml", PROFILED.replace("[solver]\ndt = 0.002", "[solver]\ndt = 0.002\n"
                                                                                   "duration = 1e9"))
-    limit_error(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), "s.toml: solver.duration",
-                "500,000,000,000 time steps", "COSIM_MAX_STEPS")
+    assert_limit_error(cosim_cli("run", str(scenario), "--out", "o.mcap", cwd=tmp_path), "s.toml: solver.duration",
+                       "500,000,000,000 time steps", "COSIM_MAX_STEPS")
     assert not (tmp_path / "o.mcap").exists()
 
 
@@ -126,9 +124,10 @@ def test_a_33_kb_log_claiming_a_1_gb_chunk_is_refused_in_little_memory(tmp_path:
     log = bomb(tmp_path / "bomb.mcap", claimed=1 << 30)
     assert log.stat().st_size < 100_000
     result, peak = _peak_memory_mb("info", str(log), cwd=tmp_path)
-    assert "chunk 1" in limit_error(result, "1,073,741,824 bytes", "COSIM_MAX_CHUNK_BYTES")
+    assert "chunk 1" in assert_limit_error(result, "1,073,741,824 bytes", "COSIM_MAX_CHUNK_BYTES")
     assert peak < 300, peak  # the imports take ~140 MB; the chunk would take 1000+
-    limit_error(cosim_cli("export", str(log), "--csv", str(tmp_path / "o.csv"), cwd=tmp_path), "COSIM_MAX_CHUNK_BYTES")
+    assert_limit_error(cosim_cli("export", str(log), "--csv", str(tmp_path / "o.csv"), cwd=tmp_path),
+                       "COSIM_MAX_CHUNK_BYTES")
     assert not (tmp_path / "o.csv").exists()
 
 

@@ -13,20 +13,11 @@ from pathlib import Path
 
 import pytest
 from _craft import rewrite
-from _robust import cosim_cli
+from _robust import assert_one_line, cosim_cli
 
 from cosim.log import open_log
 
 SECRET = b"-----BEGIN OPENSSH PRIVATE KEY----- not really\n"
-
-
-def one_line(result, *fragments: str) -> str:  # noqa: ANN001 - CliResult
-    assert result.returncode == 2, (result.stdout, result.stderr)
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("cosim: error: ") and "Traceback" not in result.stderr, lines
-    for fragment in fragments:
-        assert fragment in lines[0], (fragment, lines[0])
-    return lines[0]
 
 
 def no_secret_anywhere(folder: Path) -> None:
@@ -54,7 +45,7 @@ def test_a_road_profile_outside_the_log_is_refused(profiled_log: Path, tmp_path:
             "scenario.toml": text.replace('profile = "data/road.csv"', f'profile = "{name}"').encode()},
             metadata={"cosim": {"inputs": json.dumps({})}})
         result = cosim_cli("replay", str(crafted), "--out", str(tmp_path / "new.mcap"), "--quiet", cwd=tmp_path)
-        one_line(result, "road.profile", "not one of the log's attachments")
+        assert_one_line(result, 2, "road.profile", "not one of the log's attachments")
         assert not (tmp_path / "new.mcap").exists() and not (tmp_path / "runs").exists()
     no_secret_anywhere(tmp_path)
 
@@ -67,7 +58,7 @@ def test_a_road_profile_that_is_a_local_text_file_is_not_echoed(profiled_log: Pa
     crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", attachments={"scenario.toml": scenario},
                       metadata={"cosim": {"inputs": "{}"}})
     result = cosim_cli("replay", str(crafted), "--quiet", cwd=tmp_path)
-    line = one_line(result, "road.profile")
+    line = assert_one_line(result, 2, "road.profile")
     assert "secret-second-line" not in result.stderr + result.stdout and str(passwd) in line
     # With the log's inputs record intact, the key is pointed back at the log's own attachment.
     crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", attachments={"scenario.toml": scenario})
@@ -89,7 +80,7 @@ def test_files_named_by_the_embedded_sumo_config_must_be_attachments(sumo_log: P
     assert config != open_log(sumo_log).attachments["sumo/light.sumocfg"].decode()
     crafted = rewrite(sumo_log, tmp_path / "crafted.mcap", attachments={"sumo/light.sumocfg": config.encode()})
     result = cosim_cli("replay", str(crafted), "--out", str(tmp_path / "new.mcap"), "--quiet", cwd=tmp_path)
-    one_line(result, option, "not one of the log's attachments")
+    assert_one_line(result, 2, option, "not one of the log's attachments")
     assert not (tmp_path / "new.mcap").exists()
     no_secret_anywhere(tmp_path)
 
@@ -98,17 +89,17 @@ def test_files_named_by_the_embedded_sumo_config_must_be_attachments(sumo_log: P
 def test_an_attachment_with_an_unsafe_name_is_refused(profiled_log: Path, tmp_path: Path, name: str) -> None:
     crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", attachments={name: b"x,r\n0,0\n"})
     result = cosim_cli("replay", str(crafted), "--quiet", cwd=tmp_path)
-    one_line(result, "unsafe name")
+    assert_one_line(result, 2, "unsafe name")
     assert not (tmp_path.parent / "evil.csv").exists() and not Path("/tmp/evil.csv").exists()
 
 
 def test_an_input_the_log_does_not_hold_is_refused(profiled_log: Path, tmp_path: Path) -> None:
     crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", attachments={"data/road.csv": None})
     result = cosim_cli("replay", str(crafted), "--quiet", cwd=tmp_path)
-    one_line(result, "data/road.csv", "missing")
+    assert_one_line(result, 2, "data/road.csv", "missing")
     crafted = rewrite(profiled_log, tmp_path / "crafted.mcap",
                       metadata={"cosim": {"inputs": json.dumps({"bridge.section": "data/road.csv"})}})
-    one_line(cosim_cli("replay", str(crafted), "--quiet", cwd=tmp_path), "unknown key")
+    assert_one_line(cosim_cli("replay", str(crafted), "--quiet", cwd=tmp_path), 2, "unknown key")
 
 
 def test_the_genuine_logs_still_replay_bit_for_bit(profiled_log: Path, sumo_log: Path, tmp_path: Path) -> None:
