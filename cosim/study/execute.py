@@ -371,9 +371,11 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
                 guard.closing = True  # connected: hold signals from here on
             else:
                 n = min(workers or default_workers(), len(todo))
+                # The scheduler always serves HTTP (None means its default, 8787: taken by a second study
+                # or a notebook's cluster, it prints a warning); a free port, on this machine only.
                 with _terminal_signals_ignored():  # the worker processes start with these ignored
                     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, silence_logs=logging.ERROR)
+                                           dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
                 client = Client(cluster)
         except BaseException:
             if cluster is not None:

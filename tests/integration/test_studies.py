@@ -9,6 +9,7 @@ while the others finish, and gzipped SUMO files sweep like plain ones.
 """
 from __future__ import annotations
 
+import contextlib
 import gzip
 import json
 import os
@@ -260,13 +261,16 @@ def test_an_interrupted_study_resumes_without_redoing_finished_runs(small_study,
     out = tmp_path / "out"
     script = tmp_path / "go.py"
     script.write_text(RUN_STUDY)
-    proc = subprocess.Popen([sys.executable, str(script), str(study_path), str(out)], cwd=tmp_path,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    started = time.monotonic()
-    while not _ok_runs(out) and time.monotonic() - started < 120 and proc.poll() is None:
-        time.sleep(0.02)
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
+    with contextlib.ExitStack() as taken:
+        with contextlib.suppress(OSError):  # Dask's default dashboard port, taken (as by a second study): no warning
+            taken.enter_context(socket.create_server(("127.0.0.1", 8787)))
+        proc = subprocess.Popen([sys.executable, str(script), str(study_path), str(out)], cwd=tmp_path,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        started = time.monotonic()
+        while not _ok_runs(out) and time.monotonic() - started < 120 and proc.poll() is None:
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
     assert proc.returncode != 0, f"the study finished before it was interrupted:\n{err[-2000:]}"
     assert err.strip() == "stopped: Interrupted (SIGINT)", err  # cosim.errors.Interrupted; no traceback from Dask
     finished = _ok_runs(out)

@@ -227,7 +227,7 @@ def test_a_second_signal_stops_the_wait_for_the_runs_in_progress(tmp_path: Path,
     from dask.distributed import Client, LocalCluster
 
     stop, release, rows = tmp_path / ".stop", tmp_path / "release", []
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address="127.0.0.1:0") as cluster, \
             Client(cluster) as client:
         future = client.submit(_a_run_that_stops_when_told, stop, release, key="cosim-run-a", pure=False)
         wait_for(lambda: any(client.processing().values()), 30)
