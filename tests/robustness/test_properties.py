@@ -66,7 +66,7 @@ def _set(data: object, path: tuple, value: object) -> None:
 _DELETE = object()
 
 
-def _load(text: str, folder: Path) -> None:
+def assert_loads_or_fails_with_one_line(text: str, folder: Path) -> None:
     """Parse a scenario: a Scenario or a ConfigError whose message is one self-contained first line."""
     try:
         scenario = parse_scenario(text, "s.toml", base_dir=folder)
@@ -102,7 +102,7 @@ def test_a_mutated_scenario_loads_or_fails_with_one_line(folder: Path, data: st.
         text = toml_dumps(doc)
     except (TypeError, ValueError):
         assume(False)
-    _load(text, folder)
+    assert_loads_or_fails_with_one_line(text, folder)
 
 
 @SETTINGS
@@ -113,14 +113,14 @@ def test_a_random_document_fails_with_one_line(folder: Path, doc: dict) -> None:
         text = toml_dumps(doc)
     except (TypeError, ValueError):
         assume(False)
-    _load(text, folder)
+    assert_loads_or_fails_with_one_line(text, folder)
 
 
 @SETTINGS
 @given(st.binary(max_size=60), st.integers(0, len(PROFILED)))
 def test_garbage_spliced_into_a_scenario_text_fails_with_one_line(folder: Path, junk: bytes, at: int) -> None:
     text = PROFILED[:at] + junk.decode("utf-8", "replace") + PROFILED[at:]
-    _load(text, folder)
+    assert_loads_or_fails_with_one_line(text, folder)
 
 
 @SETTINGS
@@ -130,13 +130,13 @@ def test_a_random_road_profile_file_loads_or_fails_with_one_line(folder: Path, r
     target = folder / "random" / "data"
     target.mkdir(parents=True, exist_ok=True)
     (target / "road.csv").write_bytes(("\n".join(",".join(map(str, row)) for row in rows)).encode() + tail)
-    _load(PROFILED, target.parent)
+    assert_loads_or_fails_with_one_line(PROFILED, target.parent)
 
 
 # --------------------------------------------------------------------------- log reader
 
 
-def _read_everything(path: Path) -> None:
+def assert_read_or_refused_with_one_line(path: Path) -> None:
     """Every reader on a file: LogError, or results that are what they claim."""
     try:
         overview = open_log(path)
@@ -178,7 +178,7 @@ def test_a_mutated_log_is_read_or_refused_with_one_line(log_bytes: bytes, tmp_pa
             break
     path = tmp_path_factory.mktemp("mutated") / "log.mcap"
     path.write_bytes(bytes(raw))
-    _read_everything(path)
+    assert_read_or_refused_with_one_line(path)
 
 
 @SETTINGS
@@ -187,7 +187,7 @@ def test_random_bytes_after_the_magic_are_refused_with_one_line(tmp_path_factory
                                                                 body: bytes) -> None:
     path = tmp_path_factory.mktemp("random") / "log.mcap"
     path.write_bytes(b"\x89MCAP0\r\n" + body)
-    _read_everything(path)
+    assert_read_or_refused_with_one_line(path)
 
 
 # --------------------------------------------------------------------------- the compiled schema checks
