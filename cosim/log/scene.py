@@ -474,7 +474,8 @@ class SceneWriter:
         m_r, m_l = right @ self._mark_matrix.T, left @ self._mark_matrix.T
         marks = (m_r + (self._marks[:, 1] - y_min) / (y_max - y_min) * (m_l - m_r)) * e + 0.3
         ns = np.rint(np.asarray(times, dtype=np.float64) * 1e9).astype(np.int64)  # as _time
-        stamps = np.column_stack([ns // 1_000_000_000, ns % 1_000_000_000]).astype(np.float64)
+        seconds, nanoseconds = np.divmod(ns, 1_000_000_000)
+        stamps = np.column_stack([seconds, nanoseconds]).astype(np.float64)
         columns = [stamps, stamps, deck]
         if self.paths:
             columns += [stamps, paths]
@@ -497,9 +498,9 @@ class SceneWriter:
             heavy = {owner: len(cols) > 1 or max(getattr(report.models[j], "total_mass", 0.0) for j in cols) > HEAVY_KG
                      for owner, cols in groups.items()}
         datas: list[bytes] = []
-        seconds, nanoseconds = (ns // 1_000_000_000).tolist(), (ns % 1_000_000_000).tolist()
+        stamp_of = list(zip(seconds.tolist(), nanoseconds.tolist()))
         for i, k in enumerate(rows):
-            cars = self._vehicles((seconds[i], nanoseconds[i]), report, k, groups, heavy, x[i], near[i], z[i]) \
+            cars = self._vehicles(stamp_of[i], report, k, groups, heavy, x[i], near[i], z[i]) \
                 if vehicles else []
             datas.append(b",".join([scenes[i], *cars]) + b"]}")
         self.rec.write_encoded(TOPIC_SCENE, times, datas)
