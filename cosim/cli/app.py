@@ -522,6 +522,24 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Options whose value may begin with "-": SUMO edge ids (OSM imports name a street's reverse direction "-<id>").
+_DASH_VALUES = ("--edge",)
+
+
+def _dash_values_joined(argv: list[str]) -> list[str]:
+    """``--edge -148050455#0`` as ``--edge=-148050455#0``: argparse would read the id as an option."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        if argv[i] in _DASH_VALUES and i + 1 < len(argv) and argv[i + 1][:1] == "-" and argv[i + 1][:2] != "--":
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(argv[i])
+        i += 1
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``cosim`` command line; returns the exit status.
 
@@ -530,7 +548,7 @@ def main(argv: list[str] | None = None) -> int:
     """
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args = parser.parse_args(_dash_values_joined(sys.argv[1:] if argv is None else list(argv)))
     except SystemExit as exc:  # --help, --version (0) and usage errors (2)
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     try:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shlex
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,15 @@ import numpy as np
 from cosim.errors import CosimError
 from cosim.plots import network_figure
 from cosim.run.outputs import check_new_file
-from cosim.sumo.network import BridgeLocation, bridge_candidates, lane_shapes, locate_bridge, net_path
+from cosim.sumo.network import (
+    BridgeLocation,
+    bridge_candidates,
+    edge_options,
+    lane_shapes,
+    locate_bridge,
+    net_path,
+    wheel_paths_beyond,
+)
 
 from .text import print_lines
 
@@ -65,13 +74,14 @@ def _candidate_lines(net: Path, args: argparse.Namespace) -> list[str]:
         distance = f"{math.dist(c.middle, near):.0f} m away" if near is not None else ""
         extra = "; ".join(x for x in (", ".join(c.names), f"OSM bridge={'/'.join(c.osm_bridge)}"
                                       if c.osm_bridge else "", distance) if x)
-        rows.append((" ".join(f"--edge {e}" for e in c.edges), c.kind, f"{c.length:.1f}",
+        rows.append((edge_options(c.edges), c.kind, f"{c.length:.1f}",
                      " + ".join(str(n) for n in c.lanes), where, extra))
     heads = ("edges", "kind", "length [m]", "lanes", "middle (x, y)", "")
     widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(heads[:-1])]
     fmt = "  " + "  ".join(f"{{:<{w}}}" for w in widths) + "  {}"
     lines += [fmt.format(*heads).rstrip(), *(fmt.format(*r).rstrip() for r in rows)]
-    lines.append(f"Describe one and get its scenario lines: cosim bridge {args.network} --edge ID [--edge ID]")
+    lines.append(f"Describe one and get its scenario lines: cosim bridge {shlex.quote(str(args.network))} "
+                 "--edge=ID [--edge=ID]")
     return lines
 
 
@@ -94,6 +104,12 @@ def _location_lines(loc: BridgeLocation, source: Path, args: argparse.Namespace)
     for lane in loc.lanes:
         lines.append(f"  lane {lane.id}: y = {lane.y:+.3f} m, {lane.width:.2f} m wide, "
                      f"{'+x' if lane.direction > 0 else '-x'}, x = {lane.x_range[0]:.2f} to {lane.x_range[1]:.2f} m")
+    beyond = wheel_paths_beyond(loc, loc.carriageway, "the carriageway")
+    if beyond:
+        lines.append(f"  {beyond}")
+    for lane in loc.footways:
+        lines.append(f"  sidewalk {lane.id}: y = {lane.y:+.3f} m, {lane.width:.2f} m wide: not loaded (cosim models no "
+                     "pedestrians), so the deck need not cover it")
     if loc.opposite:
         lines.append(f"  also watched in a run: {', '.join(loc.opposite)} (the other direction between the same "
                      "junctions; name it too if the deck carries it)")

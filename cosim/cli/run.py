@@ -219,6 +219,11 @@ def _sumo_lines(plan: SumoPlan) -> list[str]:
         also = f"; also watched: {', '.join(location.opposite)} (opposite direction)" if location.opposite else ""
         lines.append(f"Deck lanes: {lanes}; carriageway y = {location.carriageway[0]:.2f} to "
                      f"{location.carriageway[1]:.2f} m{also}")
+        from cosim.sumo.network import wheel_paths_beyond
+
+        beyond = wheel_paths_beyond(location, plan.deck_y)
+        if beyond:
+            lines.append(f"  {beyond}")
     types = plan.types
     lines.append(f"Vehicle types ({len(types)}): model, gross mass, axles, suspension, and where each came from "
                  "(vType params, SUMO mass, cosim default)")
@@ -364,6 +369,10 @@ def _run_lines(outcome: RunOutcome) -> list[str]:
     if events:
         lines.append("  the contact is kept (bilateral) through a lift-off, as in the paper: "
                      "results after it assume the wheel stays on the deck")
+    if result.offdeck_events:
+        lines.append(f"Off the deck: {result.offdeck_events} times a wheel went beside the deck's surface over its "
+                     f"length ({result.offdeck_steps} wheel-steps); it loaded nothing there (\"offdeck\" events in "
+                     "the log name each): widen the section's deck if those lanes are on the bridge")
     wall = result.wall_time
     factor = f"{duration / wall:.3g}" if wall > 0 else "inf"
     lines.append(f"Time stepping: {result.steps} steps in {wall:.2f} s wall time; "

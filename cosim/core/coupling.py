@@ -59,7 +59,9 @@ class BlockReport:
     ``on_deck`` says where a vehicle was on the deck; contact forces (N,
     compression positive) are zero elsewhere; ``lifted`` marks the steps where
     a wheel on the deck pulled (negative contact force: lift-off, counted by the
-    compiled loop); ``sensors`` is (K, s).
+    compiled loop); ``sensors`` is (K, s); ``off_surface`` marks the steps where a
+    wheel was over the deck's length but beside its surface (its lateral ``y``
+    beyond the deck's width): it loaded nothing then (rigid ground).
     """
 
     ids: tuple[str, ...]
@@ -74,6 +76,7 @@ class BlockReport:
     body_acceleration: npt.NDArray[np.float64]
     sensors: npt.NDArray[np.float64]
     lifted: npt.NDArray[np.bool_]
+    off_surface: npt.NDArray[np.bool_] | None = None
 
 
 def _fleet_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray,
@@ -180,11 +183,16 @@ class CoupledSystem:
         self.n_steps = 0
         self._counters = np.zeros(4, dtype=np.int64)  # lift-off events, lift-off steps, solves, diverged
         c_w, c_t, _ = bridge._deck_coefficients
+        y_min, y_max = bridge.section.deck_y
+        tol = _Y_TOL * max(y_max - y_min, 1.0)
+        self._y_range = (float(y_min - tol), float(y_max + tol))  # the deck's surface, round-off of lanes allowed
         self._deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
                                         float(bridge.section.y_s), float(bridge.length),
-                                        np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS)
+                                        np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS, *self._y_range)
         self._scheme = kernels.StepScheme(self.dt, scheme.beta, scheme.gamma, scheme.alpha)
-        self._y_range = bridge.section.deck_y
+        self._off: dict[str, bool] = {}  # contact points beside the surface at the end of the last block
+        self.offdeck_events = 0  # times a wheel over the deck's length went beside its surface
+        self.offdeck_steps = 0  # wheel-steps beside the surface over the deck's length
         # Fleet (structure of arrays).
         self.ids: tuple[str, ...] = ()
         self._kind = np.zeros(0, dtype=np.int64)
@@ -284,26 +292,20 @@ class CoupledSystem:
         self._switch_engine("basis")
         self._state = kernels.BridgeState(values[0], values[1], values[2], self._state.force)
 
+    def on_surface(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.bool_]:
+        """Which wheel paths ``y`` (m) lie on the deck's surface (its width, round-off allowed)."""
+        return (y >= self._y_range[0]) & (y <= self._y_range[1])
+
     def _deck_w(self, x: float, y: float) -> float:
-        if not kernels.on_deck(x, self.bridge.length):
+        if not kernels.on_deck(x, self.bridge.length) or not bool(self.on_surface(np.array([y]))[0]):
             return 0.0
         row = self.bridge.deck_point_row(x, y)
         return float(self.basis.reduce_rows(row.dofs[None, :], row.values[:1])[0] @ self.d)
-
-    def _check_paths(self, block: TrafficBlock) -> None:
-        y_min, y_max = self._y_range
-        tol = _Y_TOL * max(y_max - y_min, 1.0)
-        bad = np.flatnonzero(~((block.y >= y_min - tol) & (block.y <= y_max + tol)))
-        if len(bad):
-            j = int(bad[0])
-            raise ConfigError(f"vehicle {block.ids[j]}: its wheel path y = {block.y[j]:g} m lies off the deck "
-                              f"({y_min:g} <= y <= {y_max:g} m); put it on a lane of this bridge")
 
     def _sync(self, block: TrafficBlock) -> None:
         """Match the fleet to the block's vehicles; newcomers stand at static equilibrium."""
         if block.ids == self.ids:
             return
-        self._check_paths(block)
         self._store_linear_states()
         old = {vid: i for i, vid in enumerate(self.ids)}
         q = len(block.ids)
@@ -406,8 +408,11 @@ class CoupledSystem:
     def advance(self, block: TrafficBlock) -> BlockReport:
         """Advance ``K = len(block.x)`` steps; row k of the block is the traffic at ``t + (k+1) dt``.
 
+        A wheel over the deck's length but beside its surface loads nothing (rigid ground) and is reported in
+        :attr:`BlockReport.off_surface` and counted (:attr:`offdeck_events`, :attr:`offdeck_steps`).
+
         Raises:
-            ConfigError: a vehicle's wheel path off the deck, or an unknown model.
+            ConfigError: an unknown model.
             ModelError: the solution diverged (non-finite bridge acceleration).
         """
         self._sync(block)
@@ -437,7 +442,23 @@ class CoupledSystem:
         self.t += K * self.dt
         self.n_steps += K
         return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
-                           out.body_u, out.body_a, out.sensors, out.lifted)
+                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block))
+
+    def _beside_surface(self, block: TrafficBlock) -> npt.NDArray[np.bool_]:
+        """The block's steps at which a wheel was over the deck's length but beside its surface (it loaded
+        nothing then), counted: an event each time a wheel goes there, and every such wheel-step."""
+        K, q = block.x.shape
+        beside = ~self.on_surface(block.y)
+        off = np.zeros((K, q), dtype=bool)
+        if beside.any():
+            cols = np.flatnonzero(beside)
+            off[:, cols] = kernels.on_deck(block.x[:, cols], self.bridge.length)
+            self.offdeck_steps += int(off.sum())
+            before = np.array([self._off.get(block.ids[j], False) for j in cols])
+            went = np.diff(np.vstack([before[None, :], off[:, cols]]).astype(np.int8), axis=0) > 0
+            self.offdeck_events += int(went.sum())
+        self._off = {block.ids[j]: bool(off[-1, j]) for j in np.flatnonzero(beside)} if K else self._off
+        return off
 
     def step(self, frame: TrafficFrame) -> BlockReport:
         """Advance one step; ``frame`` describes the vehicles at ``t + dt``."""

@@ -50,8 +50,10 @@ BasisArrays = namedtuple("BasisArrays", [
     "reduced", "phi", "c_diag", "k_diag", "a_inv", "poly_w", "poly_t",
 ], defaults=(np.zeros((0, 0, 0)), np.zeros((0, 0, 0))))
 #: The deck: node positions (m), per-element polynomial coefficients of w and theta_x (n_el, 14, 4), the
-#: shear centre's y (m), the length (m), and the element DOFs a deck point's w depends on (from the element).
-DeckArrays = namedtuple("DeckArrays", ["nodes_x", "cw", "ct", "y_s", "length", "dofs", "node_dofs"])
+#: shear centre's y (m), the length (m), the element DOFs a deck point's w depends on (from the element), and
+#: the deck surface's lateral extent (m): a wheel beyond it is off the deck (rigid ground) at any x.
+DeckArrays = namedtuple("DeckArrays", ["nodes_x", "cw", "ct", "y_s", "length", "dofs", "node_dofs", "y_lo", "y_hi"],
+                        defaults=(-np.inf, np.inf))
 #: dt (s) and the Newmark/HHT parameters.
 StepScheme = namedtuple("StepScheme", ["dt", "beta", "gamma", "alpha"])
 #: The bridge's state in basis coordinates and F_n, its non-inertial vehicle forces of the last step (HHT).
@@ -153,7 +155,8 @@ def with_modal_polynomials(arrays: Any, deck: Any) -> Any:
 
 @compiled(inline=True)
 def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
-    """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck.
+    """Fill the element index and the (3, 14) values of w, w_x, w_xx at each contact point; e = -1 off the deck
+    (beyond its ends, or beside its surface).
 
     ``geo[i]``: the point's xi on its element, its lever y - y_s (m) and the element's length (m).
 
@@ -167,7 +170,7 @@ def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
     for i in range(q):
         elems[i] = -1
         xi_abs = x[i]
-        if not _on_deck(xi_abs, deck.length):
+        if not _on_deck(xi_abs, deck.length) or not deck.y_lo <= y[i] <= deck.y_hi:
             for k in range(cw.shape[1]):
                 vals[i, 0, k] = 0.0
                 vals[i, 1, k] = 0.0

@@ -106,6 +106,8 @@ class SimulationResult:
             ``body_acceleration``, ``contact_force``; SI units).
         liftoff_events: how many times a wheel's contact force turned negative.
         liftoff_steps: vehicle-steps with a negative contact force.
+        offdeck_events: times a wheel over the deck's length went beside its surface (it loads nothing there).
+        offdeck_steps: wheel-steps beside the surface over the deck's length.
         factorizations: effective-matrix factorisations done (counted by the basis; 1 per run).
         steps: time steps taken; wall_time: s.
         sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
@@ -119,6 +121,8 @@ class SimulationResult:
     vehicle_table: dict[str, npt.NDArray[np.float64]]
     liftoff_events: int = 0
     liftoff_steps: int = 0
+    offdeck_events: int = 0
+    offdeck_steps: int = 0
     factorizations: int = 0
     steps: int = 0
     wall_time: float = 0.0
@@ -273,6 +277,22 @@ def check_traffic_fits(bridge: BridgeModel, traffic: TrafficSource) -> None:
                           f"{bridge.length:g} m: build the traffic with length = {bridge.length:g}")
 
 
+def check_paths_on_deck(bridge: BridgeModel, traffic: TrafficSource) -> None:
+    """Raise :class:`ConfigError` for a scripted vehicle whose wheel path lies beside the deck's surface.
+
+    A scripted vehicle keeps its lateral offset for the whole run: off the deck it would never load it, which
+    is a mistake in the script, not traffic. (A traffic simulation's wheel that leaves the surface is an event
+    of the run instead: :attr:`cosim.core.coupling.BlockReport.off_surface`.)
+    """
+    y_min, y_max = bridge.section.deck_y
+    tol = 1e-9 * max(y_max - y_min, 1.0)
+    for vehicle in getattr(traffic, "vehicles", ()):
+        y = getattr(vehicle, "y", None)
+        if isinstance(y, (int, float)) and not y_min - tol <= y <= y_max + tol:
+            raise ConfigError(f"vehicle {vehicle.id}: its wheel path y = {y:g} m lies off the deck "
+                              f"({y_min:g} <= y <= {y_max:g} m); put it on a lane of this bridge")
+
+
 def check_road_covers(bridge: BridgeModel, road: RoadProfile) -> None:
     """Raise :class:`ConfigError` unless the road profile covers the deck, 0 <= x <= L."""
     x_end = road.x0 + road.dx * (road.r.shape[1] - 1)
@@ -333,6 +353,7 @@ def simulate(
     if duplicated:
         raise ConfigError(f"sensor names must be unique (got {', '.join(duplicated)} more than once)")
     check_traffic_fits(bridge, traffic)
+    check_paths_on_deck(bridge, traffic)
     if road is not None:
         check_road_covers(bridge, road)
     scheme = solver.make_scheme()
@@ -424,6 +445,8 @@ def simulate(
         vehicle_table=vehicle_table,
         liftoff_events=system.liftoff_events,
         liftoff_steps=system.liftoff_steps,
+        offdeck_events=system.offdeck_events,
+        offdeck_steps=system.offdeck_steps,
         factorizations=basis.n_factorizations,
         steps=system.n_steps,
         wall_time=time.perf_counter() - started,

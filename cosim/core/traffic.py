@@ -411,8 +411,11 @@ class FrameTraffic:
             wanted = self._whole_vehicles(ids, wanted)
         keep = np.flatnonzero(wanted)
         X, V, A = X[:, keep], V[:, keep], A[:, keep]
-        # One lateral offset per block: where the vehicle was at its last frame in the block.
+        # One lateral offset per block: where the contact point was at its last frame in the block on the deck's
+        # length (a vehicle turning off the deck at its end keeps the lane it had on it), else at its last frame.
         rows = present[:, keep]
+        on_kept = on[:, keep]
+        rows = np.where(on_kept.any(axis=0), on_kept, rows)
         last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
         Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
         return TrafficBlock(
@@ -471,43 +474,3 @@ def _ballistic_between_frames(FX: np.ndarray, FV: np.ndarray, FA: np.ndarray, se
             A[k, j] = acc
             present[k, j] = True
     return X, V, A, present
-
-
-@compiled
-def axles_on_axis(vehicles: np.ndarray, back: np.ndarray, owner: np.ndarray, origin: np.ndarray, along: np.ndarray,
-                  left: np.ndarray, y_range: tuple[float, float], x_range: tuple[float, float]
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Contact points of vehicles in bridge coordinates, from a traffic simulation's vehicle states.
-
-    Args:
-        vehicles: (n, 5 or more) per vehicle: front bumper x, y (m, network), heading (degrees, 0 = north,
-            clockwise: SUMO's angle), speed (m/s), acceleration (m/s^2), both along the heading; columns after
-            these are not read.
-        back: (m,) each contact point's distance behind the bumper, m; owner: (m,) its vehicle's row.
-        origin: the bridge axis' start (network, m); along, left: unit vectors along the axis and to its left.
-        y_range, x_range: the region kept, m (bridge coordinates: the deck's width, the watched reach).
-
-    Returns:
-        x, y (m), speed and acceleration along +x (m/s, m/s^2) of each contact point, and whether it is kept:
-        every contact point of a vehicle with any contact point in the region (one body on several axles).
-    """
-    m = len(back)
-    x, y, v, a = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
-    keep = np.empty(m, dtype=np.bool_)
-    kept_vehicle = np.zeros(vehicles.shape[0], dtype=np.bool_)
-    for i in range(m):
-        r = owner[i]
-        heading = vehicles[r, 2] * (math.pi / 180.0)
-        hx, hy = math.sin(heading), math.cos(heading)
-        dx = vehicles[r, 0] - back[i] * hx - origin[0]
-        dy = vehicles[r, 1] - back[i] * hy - origin[1]
-        x[i] = dx * along[0] + dy * along[1]
-        y[i] = dx * left[0] + dy * left[1]
-        ahead = hx * along[0] + hy * along[1]
-        v[i] = vehicles[r, 3] * ahead
-        a[i] = vehicles[r, 4] * ahead
-        if y_range[0] <= y[i] <= y_range[1] and x_range[0] <= x[i] <= x_range[1]:
-            kept_vehicle[r] = True
-    for i in range(m):
-        keep[i] = kept_vehicle[owner[i]]
-    return x, y, v, a, keep

@@ -35,7 +35,9 @@ TOPIC_SCENE_STATIC = "/cosim/scene/static"
 TOPIC_SCENE_TRANSFORM = "/cosim/scene/transform"
 
 STATUS_STATES = ("started", "running", "finished", "interrupted", "error")
-EVENT_KINDS = ("entered", "left", "liftoff", "touchdown")
+#: A wheel entered or left the deck, lifted off or touched down again, or went beside the deck's surface over its
+#: length ("offdeck": it loads nothing while there; the event carries its lateral y too).
+EVENT_KINDS = ("entered", "left", "liftoff", "touchdown", "offdeck")
 
 #: The metadata record with the run's parameters (version, scenario, dt, sensors, ...).
 METADATA_NAME = "cosim"
@@ -84,7 +86,7 @@ VEHICLES_SCHEMA = {
 EVENTS_SCHEMA = {
     "title": "cosim.TrafficEvent", "type": "object",
     "properties": {"t": _NUMBER, "vehicle": {"type": "string"}, "event": {"type": "string", "enum": list(EVENT_KINDS)},
-                   "x": _NUMBER},
+                   "x": _NUMBER, "y": {"type": "number", "description": "lateral offset (offdeck events), m"}},
     "required": ["t", "vehicle", "event"], "additionalProperties": False,
 }
 STATUS_SCHEMA = {

@@ -286,7 +286,7 @@ class _PacedTraffic:
 
 #: The per-step arrays of a :class:`cosim.core.coupling.BlockReport` (rows: steps).
 _PER_STEP = ("x", "v", "a", "on_deck", "contact_force", "body_displacement", "body_acceleration", "sensors",
-             "lifted")
+             "lifted", "off_surface")
 #: The :class:`cosim.core.coupling.BlockReport` array of a numeric vehicle field, where the names differ.
 _REPORT_ARRAYS = {"speed": "v", "acceleration": "a"}
 
@@ -325,6 +325,7 @@ class BlockLogger:
         self._next_status = status_every
         self._on: dict[str, bool] = {}
         self._lifted: dict[str, bool] = {}
+        self._off: dict[str, bool] = {}  # wheels beside the deck's surface at the end of the last block
         self._last_x: dict[str, float] = {}  # vehicles on the deck at the end of the last block: their x
         self._model_names: dict[str, str] = {}
         self._sensor_template = (b'{"t":%s' + b"".join(b"," + _template_part(n) + b":%s" for n in self.names) + b"}")
@@ -457,7 +458,8 @@ class BlockLogger:
                 self._traffic.write_frames(frames[:upto])
                 frames = frames[upto:]
             part = report if (lo, hi) == (0, len(times)) else dataclasses.replace(
-                report, **{name: getattr(report, name)[lo:hi] for name in _PER_STEP})
+                report, **{name: getattr(report, name)[lo:hi] for name in _PER_STEP
+                           if getattr(report, name) is not None})
             self._write_piece(times[lo:hi], keep[lo:hi], part)
         self._ahead = frames
 
@@ -509,6 +511,15 @@ class BlockLogger:
                     x = float(report.x[k - 1, j]) if k > 0 else self._last_x.get(ids[j], float(report.x[k, j]))
                 self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": names[int(state[k, j])],
                                                  "x": x})
+        off = report.off_surface
+        if off is not None and off.any():
+            prev_off = np.array([self._off.get(v, False) for v in ids])
+            went = np.diff(np.vstack([prev_off[None, :], off]).astype(np.int8), axis=0) > 0
+            for k, j in zip(*np.nonzero(went)):
+                t = float(times[k])
+                self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": "offdeck",
+                                                 "x": float(report.x[k, j]), "y": float(report.y[j])})
+        self._off = {v: bool(off[-1, j]) for j, v in enumerate(ids) if off[-1, j]} if off is not None else {}
         for j, vid in enumerate(ids):
             self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
             if on[-1, j]:

@@ -123,9 +123,10 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         lo, hi = location.carriageway
         if lo < deck_y[0] - DECK_FIT_TOLERANCE or hi > deck_y[1] + DECK_FIT_TOLERANCE:
             raise ConfigError(
-                f"{scenario.source}: traffic.edges: the lanes of {', '.join(t.edges)} reach y = {lo:.3f} to "
-                f"{hi:.3f} m from the derived axis; the deck (bridge.section) spans y = {deck_y[0]:g} to "
-                f"{deck_y[1]:g} m: widen the section's deck, or give [traffic] axis")
+                f"{scenario.source}: traffic.edges: the vehicle lanes of {', '.join(t.edges)} reach y = {lo:.3f} "
+                f"to {hi:.3f} m from the derived axis; the deck (bridge.section) spans y = {deck_y[0]:g} to "
+                f"{deck_y[1]:g} m: widen the section's deck, or give [traffic] axis (sidewalks need not be "
+                "covered: cosim models no pedestrians)")
     else:
         axis, axis_from = BridgeAxis((0.0, 0.0), (length, 0.0)), "the default (0, 0) -> (L, 0)"
     if location is None:

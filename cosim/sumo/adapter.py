@@ -11,10 +11,13 @@ the junction at a deck end, so each of its axles is on the deck from the
 moment it passes one end until it passes the other. Each vehicle becomes one
 contact point per axle (a quarter-car per axle, or one half-car body on all
 of them: :mod:`cosim.sumo.vtypes`), each at its distance behind the
-bumper along the heading, projected onto the bridge axis (x along the axis
-from its start point, y to the left of it); it loads the deck while that
-projection lies on it (:func:`cosim.core.traffic.on_deck`) within the deck's
-width. The frames feed :class:`cosim.core.traffic.FrameTraffic`, which the
+bumper on the path the bumper drove (:mod:`cosim.core.axle_paths`: a turning
+vehicle's rear axles stay on their lane), projected onto the bridge axis (x
+along the axis from its start point, y to the left of it); it loads the deck
+while that projection lies on it (:func:`cosim.core.traffic.on_deck`) within
+the deck's width (for a bridge placed by its axis alone, also a wheel up to
+:data:`BESIDE_DECK` beside its width over its length, which the run then
+reports as off the deck). The frames feed :class:`cosim.core.traffic.FrameTraffic`, which the
 beam sub-steps through with SUMO's ballistic motion between frames.
 
 The user's SUMO config stays theirs: SUMO runs on a copy of it and the files
@@ -40,7 +43,8 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, axles_on_axis
+from cosim.core.axle_paths import AxleTrails, axles_on_path, path_behind, record_fronts
+from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
@@ -59,6 +63,11 @@ VEHICLE_TYPES_ATTACHMENT = "vehicle-types.json"
 _EMPTY = np.zeros(0)
 #: SUMO steps between two looks for vehicles driving away beyond the watched reach (unsubscribed then).
 DROP_DEPARTED_EVERY = 20
+#: For a bridge placed by its axis alone, wheels this far beside the deck's width (m, a lane's width) over its
+#: length stay in the frames (and the lanes there are watched): a vehicle on a lane the deck does not cover is
+#: seen, and logged as off the deck, not silently left out. A bridge located by its edges needs none: the
+#: deck covers their lanes (checked before the run), and another carriageway beside it is another structure.
+BESIDE_DECK = 3.75
 #: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
 _BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
 
@@ -162,6 +171,8 @@ class SumoTraffic:
         self.types: dict[str, VehicleType] = {}
         self.frames: FrameTraffic | None = None
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
+        self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
+        self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
         self.sumo_steps = 0
         self.teleports = 0
@@ -213,6 +224,7 @@ class SumoTraffic:
                 if type_id not in self.demand.distributions and type_id not in _BUILT_IN_OTHER:
                     self._model(type_id)
             self._extend_reach()
+            self._trails = AxleTrails(self.reach)
             attach = getattr(self.frame_sink, "attach", None)
             if attach is not None:
                 import json
@@ -306,7 +318,9 @@ class SumoTraffic:
                 self.edges = (*location.edges, *location.opposite)
                 deck = location.deck_lanes
             else:
-                deck = lanes_across(net, self.axis, self.deck_y)
+                # Lanes beside the deck's width too: their wheels are seen (and logged as off the deck), not lost.
+                lo, hi = self.deck_y
+                deck = lanes_across(net, self.axis, (lo - BESIDE_DECK, hi + BESIDE_DECK))
                 self.edges = tuple(dict.fromkeys(lane.rsplit("_", 1)[0] for lane in deck))
         except ConfigError as exc:
             raise SumoError(f"{self.config}: {exc}") from None
@@ -346,6 +360,8 @@ class SumoTraffic:
         if wanted > self.reach + 1e-9 or not self.lanes:
             self.reach = wanted
             self._subscribe_lanes(net_path(self.config))
+            if self._trails is not None:
+                self._trails.ensure_reach(self.reach)
 
     # --------------------------------------------------------------- stepping
     def _model(self, type_id: str) -> None:
@@ -383,7 +399,10 @@ class SumoTraffic:
         present -= self._done
         for vid in present - self._watched:
             ls.vehicle.subscribe(vid, self._vars)
+        trails = self._trails
+        assert trails is not None
         for vid in self._watched - present:
+            trails.drop(vid)
             try:
                 ls.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - it arrived or was teleported away: nothing to undo
@@ -400,10 +419,17 @@ class SumoTraffic:
             if typ not in self.types:
                 self._model(typ)
                 self._extend_reach()  # a longer vehicle than any known so far: watch farther
-        # One contact point per axle (a vType without axles: one at mid-length), behind the bumper.
+        # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
+        # it drove (cosim.core.axle_paths).
         num = np.array([(r[P][0], r[P][1], r[H], r[S], r[A], r[tc.VAR_LENGTH]) for r in rows], dtype=float)
-        if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
-            self._drop_departed(ids, num)               # drop only keeps a far vehicle subscribed a while longer
+        for j, vid in enumerate(ids):
+            if vid not in trails.slot_of:
+                trails.add(vid)
+                self._seed_trail(vid, num[j])
+        slots = trails.slots(ids)
+        record_fronts(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count, trails.speed,
+                      self.step)
+        vehicles = ids
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(rows))
             back = 0.5 * num[:, 5]
@@ -415,14 +441,38 @@ class SumoTraffic:
                    for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
             types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
                      for typ in types for k in range(len(self._axles[typ]))]
-        # Axles on the deck's width and within the watched reach along it (a vehicle on a long lane after the
-        # deck is dropped once far from it); a vehicle's axles stay together (one body, several axles).
-        x, y, v, a, keep = axles_on_axis(num, back, owner, self._origin, *self._unit, self.deck_y, self._x_range)
+        # Axles on the deck's width (or beside it, over its length) and within the watched reach along it (a
+        # vehicle on a long lane after the deck is dropped once far from it); a vehicle's axles stay together
+        # (one body, several axles).
+        x, y, v, a, keep = axles_on_path(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count,
+                                         back, owner, self._origin, *self._unit, self.deck_y, self._x_range,
+                                         (0.0, self.axis.length, 0.0 if self._edges_wanted else BESIDE_DECK))
+        if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
+            self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]
             x, y, v, a = x[keep], y[keep], v[keep], a[keep]
         return Frame(t=t, ids=tuple(ids), x=x, y=y, v=v, a=a, types=tuple(types))
+
+    def _seed_trail(self, vid: str, row: np.ndarray) -> None:
+        """A vehicle seen for the first time: its trail starts with its lane behind its bumper (a vehicle
+        inserted on the deck has its axles on its lane behind it), as far back as the watched reach."""
+        ls = self.libsumo
+        try:
+            lane, position = ls.vehicle.getLaneID(vid), ls.vehicle.getLanePosition(vid)
+            geometry = self._lane_geometry.get(lane)
+            if geometry is None:
+                geometry = (np.asarray(ls.lane.getShape(lane), dtype=float), float(ls.lane.getLength(lane)))
+                self._lane_geometry[lane] = geometry
+        except Exception:  # noqa: BLE001 - no lane to be had (SUMO's exception types vary): the trail starts here
+            return
+        shape, length = geometry
+        if len(shape) < 2:
+            return
+        assert self._trails is not None
+        points, behind = path_behind(shape, length, position, row[:2], self.reach)
+        self._trails.seed(vid, points, behind, float(row[3]))
 
     def _drop_departed(self, ids: list[str], num: np.ndarray) -> None:
         """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
@@ -443,6 +493,8 @@ class SumoTraffic:
             vid = ids[i]
             self._done.add(vid)
             self._watched.discard(vid)
+            if self._trails is not None:
+                self._trails.drop(vid)
             try:
                 self.libsumo.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - nothing to undo

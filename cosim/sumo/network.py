@@ -37,6 +37,8 @@ import functools
 import heapq
 import io
 import math
+import re
+import shlex
 import xml.sax
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
@@ -55,6 +57,8 @@ __all__ = [
     "BridgeLocation",
     "DeckLane",
     "bridge_candidates",
+    "edge_options",
+    "wheel_paths_beyond",
     "lanes_across",
     "locate_bridge",
     "net_path",
@@ -226,6 +230,11 @@ class BridgeLocation:
         lanes_length: the named lanes' extent along the axis, m.
         lanes: the vehicle lanes of the named edges.
         carriageway: (y_min, y_max) of the outer lane edges, m from the axis.
+        footways: the named edges' lanes only pedestrians may use (sidewalks), in bridge coordinates: not part
+            of the carriageway, and not loaded (cosim models no pedestrians), so a deck need not cover them.
+        wheel_paths: where the vehicle lanes' centre lines (the wheel paths) reach farthest to each side over
+            the deck's length, 0 <= x <= L: ((y_min, lane, x), (y_max, lane, x)), m. On a straight bridge they lie
+            within the carriageway; an edge that curves against the straight axis takes them beyond it.
         junctions: the junctions at the edges' ends (id, type).
         names: street names the network kept for the edges.
         osm_bridge: the edges' OSM ``bridge`` attributes, where the network kept them.
@@ -241,6 +250,8 @@ class BridgeLocation:
     junctions: tuple[tuple[str, str], ...]
     names: tuple[str, ...]
     osm_bridge: tuple[str, ...]
+    footways: tuple[DeckLane, ...] = ()
+    wheel_paths: tuple[tuple[float, str, float], tuple[float, str, float]] = ((0.0, "", 0.0), (0.0, "", 0.0))
 
     @functools.cached_property
     def deck_lanes(self) -> tuple[str, ...]:
@@ -296,6 +307,7 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
     known = [e.getID() for e in net.getEdges()]
     found = [_edge_or_error(net, net_file, e, known) for e in edges]
     lanes = [(edge, lane) for edge in found for lane in edge.getLanes() if _is_vehicle_lane(lane)]
+    footways = [(edge, lane) for edge in found for lane in edge.getLanes() if not _is_vehicle_lane(lane)]
     if not lanes:
         raise ConfigError(f"edge(s) {', '.join(edges)} of {net_file.name} have no lane for vehicles")
     # Direction: the first named edge's lanes, first point to last.
@@ -306,14 +318,18 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
     e_dir = chord / np.linalg.norm(chord)
     n_dir = np.array([-e_dir[1], e_dir[0]])
     origin = np.asarray(lanes[0][1].getShape()[0][:2], dtype=float)
-    rows = []
-    for edge, lane in lanes:
+    centre_lines = {}
+
+    def row(edge: Any, lane: Any) -> tuple[Any, Any, float, float, int, float, float]:
         pts = _samples(lane.getShape()) - origin
         along, across = pts @ e_dir, pts @ n_dir
+        centre_lines[lane.getID()] = (along, across)
         lane_chord = np.subtract(lane.getShape()[-1][:2], lane.getShape()[0][:2])
         direction = 1 if float(np.dot(lane_chord, e_dir)) >= 0 else -1
-        rows.append((lane, edge, float(np.median(across)), float(lane.getWidth()), direction,
-                     float(along.min()), float(along.max())))
+        return (lane, edge, float(np.median(across)), float(lane.getWidth()), direction,
+                float(along.min()), float(along.max()))
+
+    rows = [row(edge, lane) for edge, lane in lanes]
     lo = min(r[2] - r[3] / 2 for r in rows)
     hi = max(r[2] + r[3] / 2 for r in rows)
     centre = 0.5 * (lo + hi)
@@ -327,10 +343,19 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
             raise ConfigError(
                 f"the lanes of edge(s) {', '.join(edges)} are {extent:.3f} m long along the derived axis, the "
                 f"bridge {length:g} m: set [bridge] spans to add up to {extent:.3f} m, or give [traffic] axis to "
-                f"place a deck of another length (cosim bridge {net_file.name} --edge {' --edge '.join(edges)} "
+                f"place a deck of another length (cosim bridge {shlex.quote(net_file.name)} {edge_options(edges)} "
                 "prints the lines)")
         mid = 0.5 * (x0 + x1)
         a, b = mid - 0.5 * length, mid + 0.5 * length
+    reach: list[tuple[float, str, float]] = []
+    for lane, *_ in rows:
+        along, across = centre_lines[lane.getID()]
+        over = (along >= a) & (along <= b)
+        if over.any():
+            k_lo, k_hi = np.argmin(np.where(over, across, np.inf)), np.argmax(np.where(over, across, -np.inf))
+            reach += [(float(across[k_lo] - centre), lane.getID(), float(along[k_lo] - a)),
+                      (float(across[k_hi] - centre), lane.getID(), float(along[k_hi] - a))]
+    wheel_paths = (min(reach), max(reach)) if reach else ((0.0, "", 0.0), (0.0, "", 0.0))
     start = origin + centre * n_dir + a * e_dir
     end = origin + centre * n_dir + b * e_dir
     axis = BridgeAxis((float(start[0]), float(start[1])), (float(end[0]), float(end[1])))
@@ -352,6 +377,9 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
         carriageway=(lo - centre, hi - centre), junctions=tuple(junctions),
         names=tuple(dict.fromkeys(n for n in (e.getName() for e in found) if n)),
         osm_bridge=tuple(dict.fromkeys(v for v in (_osm_bridge(e) for e in found) if v)),
+        wheel_paths=wheel_paths,
+        footways=tuple(DeckLane(lane.getID(), edge.getID(), y - centre, width, d, (xa - a, xb - a))
+                       for lane, edge, y, width, d, xa, xb in (row(edge, lane) for edge, lane in footways)),
     )
 
 
@@ -411,7 +439,31 @@ def watched_lanes(net_file: str | Path, deck_lanes: Iterable[str], reach: float,
     return tuple(found)
 
 
+def wheel_paths_beyond(location: BridgeLocation, deck_y: tuple[float, float], what: str = "the deck") -> str:
+    """A line saying where the lanes' centre lines (the wheel paths) leave ``what`` (its lateral extent
+    ``deck_y``, m) over the deck's length, or "" if they do not: an edge that curves against the straight axis."""
+    (lo, lane_lo, x_lo), (hi, lane_hi, x_hi) = location.wheel_paths
+    parts = []
+    if lo < deck_y[0]:
+        parts.append(f"y = {lo:.2f} m (lane {lane_lo} at x = {x_lo:.1f} m)")
+    if hi > deck_y[1]:
+        parts.append(f"y = {hi:.2f} m (lane {lane_hi} at x = {x_hi:.1f} m)")
+    if not parts:
+        return ""
+    return (f"wheel paths beyond {what} (y = {deck_y[0]:.3f} to {deck_y[1]:.3f} m): the lanes' centre lines reach "
+            f"{' and '.join(parts)}; the edge curves against the straight axis there, and a wheel beyond the deck "
+            "loads nothing (each time, an \"offdeck\" event in the log)")
+
+
 # --------------------------------------------------------------------------- candidates
+
+
+def edge_options(edges: Sequence[str]) -> str:
+    """``--edge=ID`` for each edge, quoted for a POSIX shell where needed: a command that works when pasted,
+    whatever SUMO allows in an id (``-148050455#0``, ``43[1]``, ``:J1_0``)."""
+    # "#" only starts a shell comment at a word's start, never after "--edge=": no quotes for OSM's "123#0".
+    return " ".join("--edge=" + (e if re.fullmatch(r"[\w@%+=:,./#-]+", e) else shlex.quote(e)) for e in edges)
+
 
 
 @dataclass(frozen=True)

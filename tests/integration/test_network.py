@@ -396,7 +396,7 @@ def test_cosim_bridge_lists_candidates_and_prints_lines_that_run(tmp_path, capsy
     assert main(["bridge", str(config), "--near", "720", "230", "-n", "3"]) == 0
     out = capsys.readouterr().out
     first = [line for line in out.splitlines() if line.startswith("  --edge")][0]
-    assert first.split()[:4] == ["--edge", "39", "--edge", "40"] and "two-way" in first and "41.0" in first
+    assert first.split()[:2] == ["--edge=39", "--edge=40"] and "two-way" in first and "41.0" in first
     assert main(["bridge", str(config), "--edge", "39", "--edge", "40", "--plot", str(tmp_path / "b.png")]) == 0
     out = capsys.readouterr().out
     assert (tmp_path / "b.png").stat().st_size > 10_000

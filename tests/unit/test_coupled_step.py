@@ -149,6 +149,28 @@ def test_a_vehicle_off_the_deck_loads_nothing():
     assert np.all(report.contact_force == 0.0) and np.all(report.sensors == 0.0)
 
 
+def test_a_wheel_beside_the_deck_surface_loads_nothing_and_is_counted_once_per_excursion():
+    # Deck surface y = -6.6 to 6.6 m. A moving force on the deck's length beside it (y = 7 m) for steps 3-5 of 8,
+    # on it otherwise: it loads nothing while beside (no contact force, no response at that step's start), and
+    # the excursion is one event of three wheel-steps; a wheel beside it before the deck's start is not counted.
+    bridge = _bridge()
+    dt = 5e-3
+    scheme = Scheme.newmark()
+    system = CoupledSystem(bridge, make_basis(bridge, dt, scheme), scheme, dt, sensors=(Sensor("mid", 15.0),))
+    force = MovingForce(9000.0)
+    x = np.full((1, 2), 10.0)
+    on, beside, before = (TrafficBlock(("w", "u"), (force, force), x + np.array([[0.0, -15.0]]), np.zeros((1, 2)),
+                                       np.zeros((1, 2)), np.array([y, 7.0])) for y in (0.0, 7.0, 7.0))
+    reports = [system.advance(b) for b in (on, on, beside, beside, beside, on, on)]
+    assert [bool(r.on_deck[0, 0]) for r in reports] == [True, True, False, False, False, True, True]
+    assert [bool(r.off_surface[0, 0]) for r in reports] == [False, False, True, True, True, False, False]
+    assert all(r.contact_force[0, 0] == 0.0 for r in reports[2:5]) and reports[1].contact_force[0, 0] > 0.0
+    assert not any(r.off_surface[0, 1] for r in reports)  # "u" is before the deck (x = -5 m): rigid ground
+    assert (system.offdeck_events, system.offdeck_steps) == (1, 3)
+    quiet = CoupledSystem(bridge, make_basis(bridge, dt, scheme), scheme, dt, sensors=(Sensor("mid", 15.0),))
+    assert np.all(quiet.advance(before).sensors == 0.0)  # beside from the start: the bridge stays at rest
+
+
 def test_the_basis_counts_its_factorisations_and_the_loop_its_solves():
     bridge = _bridge()
     dt, scheme = 5e-3, Scheme.newmark()

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.core.traffic import Frame, FrameTraffic, axles_on_axis
+from cosim.core.traffic import Frame, FrameTraffic
 from cosim.core.vehicles import QuarterCar
 
 CAR = QuarterCar(m_v=1500.0, m_w=150.0, k_v=6e4, c_v=4e3)
@@ -86,23 +86,11 @@ def test_block_is_numpys_formula_bit_for_bit() -> None:
     assert np.array_equal(block.a, np.where(present, acc[r_of], 0.0)[:, cols])
 
 
-def test_axles_are_projected_onto_a_rotated_axis_and_kept_with_their_vehicle() -> None:
-    angle = np.radians(30.0)  # the axis runs 30 degrees north of east from (100, 50)
-    along, left = np.array([np.cos(angle), np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)])
-    origin = np.array([100.0, 50.0])
-    # A truck driving along the axis (SUMO heading 60 degrees: clockwise from north) with its bumper 20 m along and
-    # 1.5 m to the left, axles 1.2 and 8.0 m behind it; a car driving against the axis, outside the region.
-    bumper = origin + 20.0 * along + 1.5 * left
-    car = origin + 70.0 * along - 1.5 * left
-    vehicles = np.array([[*bumper, 60.0, 15.0, 0.5], [*car, 240.0, 12.0, -1.0]])
-    back, owner = np.array([1.2, 8.0, 2.25]), np.array([0, 0, 1])
-    x, y, v, a, keep = axles_on_axis(vehicles, back, owner, origin, along, left, (-5.0, 5.0), (-12.0, 52.0))
-    # Reference: by hand, the axles lie on the axis at 20 - 1.2 and 20 - 8 m, the car's contact at 70 + 2.25 m.
-    np.testing.assert_allclose(x, [18.8, 12.0, 72.25], atol=1e-12)
-    np.testing.assert_allclose(y, [1.5, 1.5, -1.5], atol=1e-12)
-    np.testing.assert_allclose(v, [15.0, 15.0, -12.0], atol=1e-12)
-    np.testing.assert_allclose(a, [0.5, 0.5, 1.0], atol=1e-12)
-    assert keep.tolist() == [True, True, False]
-    # The truck with its front axle past the region's end: its rear axle still in it keeps both.
-    x, _, _, _, keep = axles_on_axis(vehicles, back, owner, origin, along, left, (-5.0, 5.0), (-12.0, 15.0))
-    assert keep.tolist() == [True, True, False] and x[0] > 15.0
+def test_a_vehicle_turning_off_the_deck_keeps_the_lane_it_had_on_it_for_the_block() -> None:
+    # One lateral offset per block and contact point: where it was at its last frame on the deck's length, not
+    # where it turned to after it (x = 40.3 m, 2.5 m to the side, is past the deck's end).
+    traffic = FrameTraffic(STEP, 40.0, {"car": CAR})
+    frames_of(traffic, [[("c", 39.0, -1.6, 10.0, 0.0)], [("c", 39.5, -1.6, 10.0, 0.0)],
+                        [("c", 40.0, -1.7, 10.0, 0.0)], [("c", 40.3, -4.1, 6.0, 0.0)]])
+    block = traffic.block(np.arange(1, 41) * 0.005)
+    assert block.y.tolist() == [-1.7]

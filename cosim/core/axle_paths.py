@@ -1,0 +1,292 @@
+"""Where a vehicle's axles stand: on the path its front bumper drove (docs/theory.md §6.11).
+
+A traffic simulation reports each vehicle's front bumper (position and
+heading) at every step. An axle ``b`` metres behind the bumper stands where
+the bumper was when the vehicle had driven ``b`` metres less: on the
+vehicle's own trail, not on a straight line behind the bumper along its
+present heading. The two differ wherever the heading changes within the
+vehicle's length: at a junction at a deck end, a vehicle turning off the
+bridge swings its bumper (and with it the straight line behind it) across
+the road while its rear axles are still on their lane on the deck.
+
+:class:`AxleTrails` keeps, per followed vehicle, a trail of bumper
+positions with the distance driven at each (``s``, m) in
+fixed arrays that one compiled pass appends to (:func:`record_fronts`) and
+one compiled pass reads (:func:`axles_on_path`). The distance driven between
+two steps is the bumper's move, but never more than the travel its speeds
+give (SUMO's ballistic update: the mean speed times the step), so that an
+instant lane change's sideways jump adds no distance. (SUMO's heading is the
+body's, from its back to its front: it lags the direction of travel by tens
+of degrees after a turn, so the move is not projected on it.) Where the trail under an
+axle is straight to :data:`STRAIGHT_TOLERANCE`, the axle stands on the
+straight line behind the bumper, computed exactly as before the trails
+existed (so a straight road gives the same numbers to the bit); elsewhere it
+is interpolated linearly on the trail. A vehicle seen for the first time
+has its trail seeded with the lane it is on (the caller's
+:meth:`AxleTrails.seed`): a vehicle inserted on the deck has its axles on
+its lane behind it.
+
+Error of the method (docs/theory.md §6.11): the trail is a polyline through
+bumper positions at least :data:`MIN_SPACING` and at most one step's travel
+``h`` (or MIN_SPACING, if larger) apart. On a path of radius ``R`` an axle
+lies off the true path by at most the chord's sag ``h^2 / (8 R)`` across it
+and ``b h^2 / (24 R^2)`` along it (the chords' shortfall against the arc
+over the axle's distance ``b``): 5 mm and 2 mm for h = 0.7 m (14 m/s at
+SUMO's 0.05 s step), R = 12 m (a tight junction turn), b = 14 m.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from .jit import compiled
+
+#: An axle's trail counts as straight while every trail point under it lies this close to the line behind the
+#: bumper along its heading, m: the axle then stands on that line (as before the trails, to the bit).
+STRAIGHT_TOLERANCE = 1e-3
+#: Kept trail points are at least this far apart along the trail, m (the newest is always the bumper itself).
+MIN_SPACING = 0.25
+#: Trail points beyond those that cover the reach, per vehicle (a seeded lane's vertices).
+SPARE_POINTS = 64
+
+
+def trail_capacity(reach: float) -> int:
+    """Points per vehicle trail that cover ``reach`` m behind the bumper at :data:`MIN_SPACING`."""
+    return int(math.ceil(reach / MIN_SPACING)) + SPARE_POINTS
+
+
+class AxleTrails:
+    """The trails of the followed vehicles' front bumpers (network coordinates, m), one slot per vehicle.
+
+    Args:
+        reach: how far behind a bumper an axle can be, m (the longest vehicle plus slack).
+    """
+
+    def __init__(self, reach: float) -> None:
+        self.capacity = trail_capacity(reach)
+        self.slot_of: dict[str, int] = {}
+        self._free: list[int] = []
+        self._allocate(16)
+
+    def _allocate(self, slots: int) -> None:
+        h = self.capacity
+        self.px = np.zeros((slots, h))
+        self.py = np.zeros((slots, h))
+        self.s = np.zeros((slots, h))
+        self.head = np.zeros(slots, dtype=np.int64)
+        self.count = np.zeros(slots, dtype=np.int64)
+        self.speed = np.zeros(slots)  # at the last point, m/s
+        self._free = list(range(slots - 1, -1, -1))
+
+    def _resize(self, slots: int, capacity: int) -> None:
+        """Room for ``slots`` vehicles of ``capacity`` points each, the trails kept (oldest point first)."""
+        old = (self.px, self.py, self.s, self.head, self.count, self.speed)
+        used = dict(self.slot_of)
+        self.capacity = capacity
+        self._allocate(slots)
+        self._free = [k for k in range(slots - 1, -1, -1) if k not in used.values()]
+        for k in used.values():
+            n = min(int(old[4][k]), capacity)
+            order = (old[3][k] - np.arange(n - 1, -1, -1)) % old[0].shape[1]
+            self.px[k, :n], self.py[k, :n], self.s[k, :n] = old[0][k, order], old[1][k, order], old[2][k, order]
+            self.head[k], self.count[k], self.speed[k] = n - 1, n, old[5][k]
+
+    def ensure_reach(self, reach: float) -> None:
+        """Longer trails for a longer vehicle than any before (the trails kept)."""
+        wanted = trail_capacity(reach)
+        if wanted > self.capacity:
+            self._resize(self.px.shape[0], wanted)
+
+    def add(self, vehicle: str) -> int:
+        """A slot for a vehicle seen for the first time (an empty trail)."""
+        if not self._free:
+            self._resize(2 * self.px.shape[0], self.capacity)
+        k = self._free.pop()
+        self.slot_of[vehicle] = k
+        self.count[k] = 0
+        return k
+
+    def drop(self, vehicle: str) -> None:
+        """Forget a vehicle no longer followed."""
+        k = self.slot_of.pop(vehicle, None)
+        if k is not None:
+            self.count[k] = 0
+            self._free.append(k)
+
+    def seed(self, vehicle: str, points: npt.NDArray[np.float64], behind: npt.NDArray[np.float64],
+             speed: float) -> None:
+        """Start a vehicle's trail with the path behind its bumper: ``points`` (n, 2), oldest first, the last
+        the bumper itself, each ``behind`` (n,) metres of driving before it (decreasing to 0); ``speed``: its
+        speed now, m/s."""
+        k = self.slot_of[vehicle]
+        n = min(len(points), self.capacity)
+        self.px[k, :n] = points[-n:, 0]
+        self.py[k, :n] = points[-n:, 1]
+        self.s[k, :n] = -np.asarray(behind[-n:], dtype=float)
+        self.head[k], self.count[k], self.speed[k] = n - 1, n, speed
+
+    def slots(self, vehicles: list[str]) -> npt.NDArray[np.int64]:
+        """The slot of each vehicle (all added)."""
+        return np.array([self.slot_of[v] for v in vehicles], dtype=np.int64)
+
+
+@compiled
+def record_fronts(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
+                  head: np.ndarray, count: np.ndarray, speed: np.ndarray, step: float) -> None:
+    """Append every vehicle's bumper (``vehicles`` rows: x, y (m), heading, speed (m/s), ...) to its trail, one
+    traffic step (``step``, s) after the last: the distance driven since the last point is the bumper's move,
+    at most the travel of the mean speed over the step (a lane change's sideways jump adds nothing; on a
+    curve it is the chord). The newest point is always the bumper; it replaces the newest kept point while
+    that lies less than :data:`MIN_SPACING` after the one before it."""
+    cap = px.shape[1]
+    for r in range(vehicles.shape[0]):
+        k = slots[r]
+        x, y, v = vehicles[r, 0], vehicles[r, 1], vehicles[r, 3]
+        if count[k] == 0:
+            head[k], count[k] = 0, 1
+            px[k, 0], py[k, 0], s[k, 0], speed[k] = x, y, 0.0, v
+            continue
+        h = head[k]
+        moved = math.sqrt((x - px[k, h]) ** 2 + (y - py[k, h]) ** 2)
+        travel = 0.5 * (speed[k] + v) * step
+        s_new = s[k, h] + min(moved, travel)
+        provisional = count[k] >= 2 and s[k, h] - s[k, (h - 1) % cap] < MIN_SPACING
+        if not provisional:
+            h = (h + 1) % cap
+            head[k] = h
+            count[k] = min(count[k] + 1, cap)
+        px[k, h], py[k, h], s[k, h], speed[k] = x, y, s_new, v
+
+
+@compiled
+def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
+                  head: np.ndarray, count: np.ndarray, back: np.ndarray, owner: np.ndarray, origin: np.ndarray,
+                  along: np.ndarray, left: np.ndarray, y_range: tuple[float, float], x_range: tuple[float, float],
+                  span: tuple[float, float, float]
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Contact points of vehicles in bridge coordinates, each axle on its vehicle's trail (module docstring).
+
+    Args:
+        vehicles: (n, 5 or more) per vehicle: front bumper x, y (m, network), heading (degrees, 0 = north,
+            clockwise: SUMO's angle), speed (m/s), acceleration (m/s^2), both along the heading; columns after
+            these are not read.
+        slots, px, py, s, head, count: each vehicle's trail (:class:`AxleTrails`, its bumper recorded).
+        back: (m,) each contact point's distance behind the bumper, m; owner: (m,) its vehicle's row.
+        origin: the bridge axis' start (network, m); along, left: unit vectors along the axis and to its left.
+        y_range, x_range: the region kept, m (bridge coordinates: the deck's width, the watched reach).
+        span: (x_min, x_max, margin): over this stretch of the axis (the deck's length), contact points up to
+            ``margin`` m beyond ``y_range`` are kept too (a wheel beside the deck is seen, not lost).
+
+    Returns:
+        x, y (m), speed and acceleration along +x (m/s, m/s^2) of each contact point (those along its trail's
+        direction there), and whether it is kept: every contact point of a vehicle with any contact point in
+        the region (one body on several axles).
+    """
+    m = len(back)
+    cap = px.shape[1]
+    x, y, v, a = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
+    keep = np.empty(m, dtype=np.bool_)
+    kept_vehicle = np.zeros(vehicles.shape[0], dtype=np.bool_)
+    for i in range(m):
+        r = owner[i]
+        k = slots[r]
+        heading = vehicles[r, 2] * (math.pi / 180.0)
+        hx, hy = math.sin(heading), math.cos(heading)
+        fx, fy = vehicles[r, 0], vehicles[r, 1]
+        h = head[k]
+        target = s[k, h] - back[i]
+        straight = True
+        found = -1
+        oldest = h
+        for step in range(count[k]):
+            j = (h - step) % cap
+            oldest = j
+            if abs((px[k, j] - fx) * hy - (py[k, j] - fy) * hx) > STRAIGHT_TOLERANCE:
+                straight = False
+            if s[k, j] <= target:
+                found = j
+                break
+        if straight:  # as before the trails: on the line behind the bumper
+            dx = fx - back[i] * hx - origin[0]
+            dy = fy - back[i] * hy - origin[1]
+            tx, ty = hx, hy
+        else:
+            if found >= 0:
+                base = found
+                nxt = (found + 1) % cap
+                ds = s[k, nxt] - s[k, found]
+                f = (target - s[k, found]) / ds if ds > 0.0 else 0.0
+            else:  # the trail is shorter than the axle's distance: on from its oldest point, straight
+                base = oldest
+                nxt = (oldest + 1) % cap
+                f = target - s[k, oldest]  # negative: metres before the oldest point
+            ex, ey = px[k, nxt] - px[k, base], py[k, nxt] - py[k, base]
+            norm = math.sqrt(ex * ex + ey * ey)
+            if base == h or norm == 0.0:
+                tx, ty = hx, hy
+            else:
+                tx, ty = ex / norm, ey / norm
+            if found >= 0:
+                qx, qy = px[k, base] + f * ex, py[k, base] + f * ey
+            else:
+                qx, qy = px[k, base] + f * tx, py[k, base] + f * ty
+            dx = qx - origin[0]
+            dy = qy - origin[1]
+        x[i] = dx * along[0] + dy * along[1]
+        y[i] = dx * left[0] + dy * left[1]
+        ahead = tx * along[0] + ty * along[1]
+        v[i] = vehicles[r, 3] * ahead
+        a[i] = vehicles[r, 4] * ahead
+        in_box = y_range[0] <= y[i] <= y_range[1] and x_range[0] <= x[i] <= x_range[1]
+        beside = span[0] <= x[i] <= span[1] and y_range[0] - span[2] <= y[i] <= y_range[1] + span[2]
+        if in_box or beside:
+            kept_vehicle[r] = True
+    for i in range(m):
+        keep[i] = kept_vehicle[owner[i]]
+    return x, y, v, a, keep
+
+
+def path_behind(shape: npt.ArrayLike, lane_length: float, position: float, front: npt.ArrayLike,
+                reach: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """The path behind a bumper along its lane, to seed a trail (:meth:`AxleTrails.seed`).
+
+    Args:
+        shape: the lane's centre line, (n, 2) network coordinates, m.
+        lane_length: the lane's length as the traffic simulation counts it, m (it may differ from the
+            centre line's: SUMO scales positions on the line by their ratio).
+        position: the bumper's position on the lane, m from its start (in ``lane_length``'s measure).
+        front: the bumper (network, m): the centre line is moved onto it (a vehicle off its lane's centre).
+        reach: how far back the path is wanted, m; before the lane's start it goes on straight, along the
+            lane's first segment.
+
+    Returns:
+        The points (m, 2), oldest first, the last the bumper, and each one's distance before it along the
+        path (m, decreasing to 0).
+    """
+    pts = np.asarray(shape, dtype=float)[:, :2]
+    seg = np.hypot(*np.diff(pts, axis=0).T)
+    along = np.concatenate([[0.0], np.cumsum(seg)])
+    total = float(along[-1])
+    g = position * total / lane_length if lane_length > 0 else position
+    g = min(max(g, 0.0), total)
+    at = np.array([np.interp(g, along, pts[:, 0]), np.interp(g, along, pts[:, 1])])
+    shift = np.asarray(front, dtype=float)[:2] - at
+    inner = np.flatnonzero((along < g) & (g - along < reach))
+    points = [pts[j] for j in inner]
+    behind = [g - along[j] for j in inner]
+    if g - reach <= 0.0 or not len(inner):  # on, straight, before the lane's start (or its first segment)
+        first = np.flatnonzero(seg > 0.0)
+        start_dir = (pts[first[0] + 1] - pts[first[0]]) / seg[first[0]] if len(first) else np.zeros(2)
+        if g >= reach:
+            start = np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])])
+        else:
+            start = pts[0] - (reach - g) * start_dir
+        points.insert(0, start)
+        behind.insert(0, reach)
+    elif along[inner[0]] > g - reach:  # the oldest vertex is within reach: the point at the reach before it
+        points.insert(0, np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])]))
+        behind.insert(0, reach)
+    out = np.array(points + [at]) + shift
+    return out, np.array(behind + [0.0])
