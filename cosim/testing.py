@@ -305,7 +305,7 @@ class Results:
 
     def _traffic(self) -> Any:
         if self.log_path is not None:
-            from cosim.log.reader import read_traffic
+            from cosim.log.replay_source import read_traffic
 
             traffic_cfg = self.scenario.traffic
             if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)

@@ -571,7 +571,7 @@ class BlockLogger:
 class TrafficLogger:
     """Frame sink for a live traffic source (SUMO): logs every frame with vehicles, and each new vehicle type.
 
-    These are what :func:`cosim.log.reader.traffic_from_log` needs to re-drive a bridge with
+    These are what :func:`cosim.log.replay_source.traffic_from_log` needs to re-drive a bridge with
     exactly the same vehicle kinematics (``cosim replay``). A frame without
     vehicles near the deck is not written: a missing frame is an empty one.
     """
