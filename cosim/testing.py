@@ -305,7 +305,7 @@ class Results:
 
     def _traffic(self) -> Any:
         if self.log_path is not None:
-            from cosim.log.reader import read_traffic
+            from cosim.log.replay_source import read_traffic
 
             traffic_cfg = self.scenario.traffic
             if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)
@@ -370,7 +370,9 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
     )
 
 
-def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel) -> Results:
+def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel,
+              vehicles: dict[str, dict[str, npt.NDArray[np.float64]]] | None = None) -> Results:
+    """The results of a logged run, read from its log (the vehicles' samples too if not given: when first asked)."""
     from cosim.log.reader import sensor_series
 
     result = outcome.result
@@ -380,7 +382,7 @@ def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel) -> Results:
         extremes={n: (result.sensor_min[n], result.sensor_max[n]) for n in series},
         vehicle_ids=list(result.vehicle_ids), duration=outcome.duration, liftoff_events=result.liftoff_events,
         max_on_deck=result.max_on_deck, contact_force_range=dict(result.contact_force_range),
-        log_path=Path(outcome.log_path), wall_time=outcome.wall_time, _bridge=bridge_model,
+        log_path=Path(outcome.log_path), wall_time=outcome.wall_time, _vehicles=vehicles, _bridge=bridge_model,
     )
 
 
@@ -419,8 +421,8 @@ def run(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = Non
     folder = Path(tempfile.mkdtemp(prefix="cosim-test-"))
     try:
         outcome = run_logged(sc, folder / "run.mcap", force=True, bridge=model)
-        res = _from_log(sc, outcome, model)
-        res._vehicle_table()  # read what the log holds before it goes
+        # What the log holds is read before it goes: the vehicles now, the logged traffic by quasi_static().
+        res = _from_log(sc, outcome, model, vehicles=_vehicles_from_log(Path(outcome.log_path)))
         res.quasi_static()
         res.log_path = None
         return res

@@ -6,7 +6,8 @@ import json
 import sys
 
 from cosim.core.traffic import vehicle_of
-from cosim.log.reader import LogOverview, ReadStats, file_is_complete, iter_messages, open_log
+from cosim.log.reader import LogOverview, file_is_complete, iter_messages, open_log
+from cosim.log.records import ReadStats
 from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.run.export import export_csv
 from cosim.run.figures import plot_log_sensors

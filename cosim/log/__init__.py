@@ -1,4 +1,5 @@
-"""MCAP logs of cosim runs: the format (:mod:`.schemas`), the writer (:mod:`.writer`) and the reader (:mod:`.reader`).
+"""MCAP logs of cosim runs: the format (:mod:`.schemas`), the writer (:mod:`.writer`), the reader (:mod:`.reader`,
+over the bounded MCAP record parser :mod:`.records`) and the replay's traffic source (:mod:`.replay_source`).
 
 Every message is JSON with a JSON Schema, so Foxglove and the ``mcap`` CLI can
 read the logs. Log times are integer nanoseconds of *simulated* time. The
@@ -13,10 +14,9 @@ from .reader import (
     iter_messages,
     open_log,
     read_log,
-    read_traffic,
     sensor_series,
-    traffic_from_log,
 )
+from .replay_source import read_traffic, traffic_from_log
 from .schemas import (
     EVENT_KINDS,
     METADATA_NAME,

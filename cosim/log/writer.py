@@ -22,14 +22,14 @@ import struct
 import threading
 import time
 import traceback
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 import orjson
 from mcap.opcode import Opcode
-from mcap.records import MessageIndex
+from mcap.records import MessageIndex, Statistics
 from mcap.writer import CompressionType, Writer
 
 from cosim import __version__
@@ -66,6 +66,37 @@ class _MessageIndex(MessageIndex):
         stream.finish_record()
 
 
+@dataclasses.dataclass(frozen=True)
+class _ChunkState:
+    """What :class:`_BulkWriter`'s bulk path updates of mcap's :class:`Writer`, as ``add_message`` would."""
+
+    builder: Any  # the chunk being built (mcap's ChunkBuilder: record_writer, message_indices, times, count)
+    statistics: Statistics
+    chunk_size: int
+    finish_if_full: Callable[[], None]  # writes the chunk out once it is over ``chunk_size``
+
+
+#: The chunk builder's fields the bulk path reads and updates.
+_BUILDER_FIELDS = ("record_writer", "message_indices", "message_start_time", "message_end_time", "num_messages")
+
+
+def _mcap_chunk_state(writer: Writer) -> _ChunkState | None:
+    """The chunk state of an mcap :class:`Writer`, or None if the installed mcap keeps it otherwise."""
+    # Why: mcap's Writer has no public bulk path for pre-encoded messages (tests/unit/test_log.py guards this).
+    try:
+        state = _ChunkState(builder=writer._Writer__chunk_builder,  # type: ignore[attr-defined]
+                            statistics=writer._Writer__statistics,  # type: ignore[attr-defined]
+                            chunk_size=writer._Writer__chunk_size,  # type: ignore[attr-defined]
+                            finish_if_full=writer._Writer__maybe_finalize_chunk)  # type: ignore[attr-defined]
+    except AttributeError:
+        return None
+    builder = state.builder
+    usable = (isinstance(state.statistics, Statistics) and isinstance(state.chunk_size, int)
+              and all(hasattr(builder, name) for name in _BUILDER_FIELDS)
+              and all(hasattr(builder.record_writer, name) for name in ("count", "write")))
+    return state if usable else None
+
+
 class _BulkWriter(Writer):
     """mcap's :class:`Writer` with a bulk path for many pre-encoded messages of one channel.
 
@@ -73,32 +104,30 @@ class _BulkWriter(Writer):
     ``add_message`` would write; only the Python work per message is less (one
     ``struct.pack`` and a list append instead of a record object, seven
     stream writes and their bookkeeping), which is most of the logging cost
-    at 100 Hz. If the installed mcap's internals differ, it falls back to
-    ``add_message`` per message.
+    at 100 Hz. If the installed mcap's internals differ (:func:`_mcap_chunk_state`),
+    it falls back to ``add_message`` per message.
     """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._chunk_state = _mcap_chunk_state(self)
 
     def add_encoded(self, channel_id: int, log_times: list[int], datas: list[bytes], sequence: int) -> int:
         """Add ``datas[i]`` at ``log_times[i]`` (ns, also the publish time); returns the last sequence number."""
-        try:
-            builder = self._Writer__chunk_builder  # type: ignore[attr-defined]
-            stats = self._Writer__statistics  # type: ignore[attr-defined]
-            limit = self._Writer__chunk_size  # type: ignore[attr-defined]
-            builder.record_writer._buffer.tell()
-            finalize = self._Writer__maybe_finalize_chunk  # type: ignore[attr-defined]
-        except AttributeError:
-            builder = None
-        if builder is None:
+        state = self._chunk_state
+        if state is None:
             for ns, data in zip(log_times, datas):
                 sequence += 1
                 self.add_message(channel_id, ns, data, ns, sequence)
             return sequence
+        builder, stats, limit, finalize = state.builder, state.statistics, state.chunk_size, state.finish_if_full
         pack = _MESSAGE_HEAD.pack
         sizes = [9 + _MESSAGE_FIXED + len(d) for d in datas]
         ends = list(itertools.accumulate(sizes))  # record ends relative to the batch start
         start, n = 0, len(datas)
         while start < n:
-            buffer = builder.record_writer._buffer  # a new one after every finished chunk
-            base = buffer.tell()
+            records_out = builder.record_writer  # the chunk's records (emptied after every finished chunk)
+            base = records_out.count
             skipped = ends[start - 1] if start else 0
             # Records up to and including the first one that takes the chunk past its size, as add_message does.
             stop = min(bisect.bisect_right(ends, limit - base + skipped, lo=start) + 1, n)
@@ -109,7 +138,7 @@ class _BulkWriter(Writer):
             parts[0::2] = [pack(_MESSAGE_OPCODE, size - 9, channel_id, seq, ns, ns)
                            for size, seq, ns in zip(sizes[start:stop], seqs, times)]
             parts[1::2] = datas[start:stop]
-            buffer.write(b"".join(parts))
+            records_out.write(b"".join(parts))
             offsets = [base + e - skipped - size for e, size in zip(ends[start:stop], sizes[start:stop])]
             sequence += count
             first, last = min(times), max(times)
@@ -582,7 +611,7 @@ class BlockLogger:
 class TrafficLogger:
     """Frame sink for a live traffic source (SUMO): logs every frame with vehicles, and each new vehicle type.
 
-    These are what :func:`cosim.log.reader.traffic_from_log` needs to re-drive a bridge with
+    These are what :func:`cosim.log.replay_source.traffic_from_log` needs to re-drive a bridge with
     exactly the same vehicle kinematics (``cosim replay``). A frame without
     vehicles near the deck is not written: a missing frame is an empty one.
     """

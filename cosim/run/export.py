@@ -8,7 +8,8 @@ from typing import Any
 
 from cosim.core.fields import VEHICLE_FIELDS
 from cosim.errors import CosimError
-from cosim.log.reader import ReadStats, check_window, iter_messages, open_log
+from cosim.log.reader import check_window, iter_messages, open_log
+from cosim.log.records import ReadStats
 from cosim.log.schemas import (
     EVENTS_SCHEMA,
     STATUS_SCHEMA,

@@ -16,7 +16,8 @@ import numpy as np
 from cosim import plots
 from cosim.core.bridge import BridgeModel, ModalResult
 from cosim.errors import CosimError, LogError
-from cosim.log.reader import ReadStats, check_window, iter_messages, open_log
+from cosim.log.reader import check_window, iter_messages, open_log
+from cosim.log.records import ReadStats
 from cosim.log.schemas import TOPIC_SENSORS
 
 from .outputs import atomic_write, check_new_file, check_not_input

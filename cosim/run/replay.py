@@ -19,7 +19,8 @@ from pathlib import Path, PurePosixPath
 from typing import Any
 
 from cosim.errors import ConfigError, LogError
-from cosim.log.reader import LoggedTraffic, LogOverview, check_messages, iter_messages, open_log
+from cosim.log.reader import LogOverview, check_messages, iter_messages, open_log
+from cosim.log.replay_source import LoggedTraffic
 from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.sumo.files import FILE_OPTIONS, read_config
 

@@ -19,7 +19,8 @@ from mcap.reader import make_reader
 
 from cosim.errors import CosimError, LogError
 from cosim.log import TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_STATUS, TOPIC_VEHICLES
-from cosim.log.reader import ReadStats, iter_messages, open_log, sensor_series
+from cosim.log.reader import iter_messages, open_log, sensor_series
+from cosim.log.records import ReadStats
 from cosim.log.schemas import to_ns
 from cosim.run.export import export_csv
 from cosim.run.figures import sensor_history

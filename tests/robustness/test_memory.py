@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from cosim.log import LogRecorder, open_log, read_log, sensor_series, traffic_from_log
-from cosim.log.reader import LoggedTraffic
+from cosim.log.replay_source import LoggedTraffic
 from cosim.run.figures import MAX_PLOT_POINTS, sensor_envelope
 
 

@@ -7,13 +7,16 @@ Layers, from the bottom: ``cosim.errors``; the numerical core ``cosim.core``
 ``cosim.run``; ``cosim.study`` and ``cosim.validation`` on top of it; the
 scenario-testing API ``cosim.testing``; the command line ``cosim.cli``.
 Dependencies point down only, modules of one layer do not import each other
-across packages, and no module imports another's private names. The import
+across packages, and no module imports or reads another's private names
+(nor a third-party package's, but for one isolated function), nor is over
+800 lines (issue 24; the modules still over it are listed as pending). The import
 graph is read from the source (every ``import``, lazy ones inside functions
 included), not maintained by hand.
 """
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -143,3 +146,130 @@ def test_importing_the_numerical_core_loads_no_adapter_plotting_or_configuration
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", f"importing {part} loaded {out.stdout.strip()}"
+
+
+# --------------------------------------------------------------------------- size of a module, private names
+
+#: Lines a module may have: a module over it holds several concepts (issue 24).
+MAX_MODULE_LINES = 800
+
+#: Pending in issue 24: modules still over :data:`MAX_MODULE_LINES`, to be split by their owners (and then
+#: removed from here; the lead empties this list). Do not add to it: split the module instead.
+PENDING_LONG_MODULES = {
+    "cosim/validation/cases.py",  # 1,196 lines: the validation cases
+    "cosim/core/section.py",  # 889 lines: the section solver and its constants
+}
+
+
+def _relative(path: Path) -> str:
+    return path.relative_to(PACKAGE.parent).as_posix()
+
+
+def test_no_module_is_over_800_lines():
+    long = {}
+    for path in _modules().values():
+        lines = len(path.read_text(encoding="utf-8").splitlines())
+        if lines > MAX_MODULE_LINES and _relative(path) not in PENDING_LONG_MODULES:
+            long[_relative(path)] = lines
+    assert not long, (f"modules over {MAX_MODULE_LINES} lines (split them along their concepts): "
+                      + ", ".join(f"{p} ({n})" for p, n in sorted(long.items())))
+
+
+def _nodes_by_function(tree: ast.AST) -> list[tuple[str, ast.AST]]:
+    """Every node of a module with the qualified name of the function (or class) around it ("" at the top)."""
+    out: list[tuple[str, ast.AST]] = []
+
+    def visit(node: ast.AST, where: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = where
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                inner = f"{where}.{child.name}" if where else child.name
+            out.append((inner, child))
+            visit(child, inner)
+
+    visit(tree, "")
+    return out
+
+
+#: A name-mangled attribute (``obj._Class__name``): another class's private attribute, read from outside it.
+MANGLED = re.compile(r"^_[A-Za-z][A-Za-z0-9]*__\w+$")
+
+#: The one function that reads a third-party object's name-mangled attributes, and why: mcap's Writer has no
+#: public bulk path for pre-encoded messages (tests/unit/test_log.py fails if mcap's internals change).
+MANGLED_READER = ("cosim/log/writer.py", "_mcap_chunk_state")
+
+
+def test_no_name_mangled_attribute_is_read_outside_the_one_isolated_function():
+    problems, isolated = [], 0
+    for path in _modules().values():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for where, node in _nodes_by_function(tree):
+            if isinstance(node, ast.Attribute):
+                name = node.attr
+            elif isinstance(node, ast.Constant) and isinstance(node.value, str):
+                name = node.value  # getattr(obj, "_Class__name")
+            else:
+                continue
+            if not MANGLED.match(name):
+                continue
+            if (_relative(path), where) == MANGLED_READER:
+                isolated += 1
+            else:
+                problems.append(f"{_relative(path)}:{node.lineno} ({where or 'module'}): reads {name}")
+    assert not problems, ("name-mangled attributes read outside "
+                          f"{MANGLED_READER[0]}:{MANGLED_READER[1]}:\n" + "\n".join(problems))
+    assert isolated, f"{MANGLED_READER} reads no name-mangled attribute: update MANGLED_READER"
+
+
+#: Names with a leading underscore that are public API (namedtuple's methods and attributes).
+PUBLIC_UNDERSCORE = {"_replace", "_asdict", "_fields", "_make", "_field_defaults"}
+
+#: Pending in issue 24 (item 6): reads and writes of another module's or package's private names, outside
+#: cosim.log, to be removed by their owners (and then from here; the lead empties this list).
+PENDING_PRIVATE_READS = {
+    ("cosim/core/coupling.py", "_deck_coefficients"),  # BridgeModel's, read by CoupledSystem
+    ("cosim/core/jit.py", "_locator_classes"),  # numba's cache locators, extended with cosim's
+    ("cosim/core/jit.py", "_CacheImpl"),  # imported from numba.core.caching
+    ("cosim/cli/app.py", "_negative_number_matcher"),  # argparse's, so that "--from -5" is a value
+}
+
+
+def _own_names(tree: ast.AST) -> set[str]:
+    """The names a module defines itself: its functions and classes, and every name or attribute it assigns."""
+    own = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            own.add(node.name)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            own.add(node.id)
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store) \
+                and isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"):
+            own.add(node.attr)
+    return own
+
+
+def test_no_module_reads_another_modules_or_packages_private_names():
+    """``obj._name`` (not ``self``'s or ``cls``'s, nor a name the module defines itself), ``getattr(obj,
+    "_name")`` and ``from package import _name``: reaching into what another module or package keeps private."""
+    problems = []
+    for path in _modules().values():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        own = _own_names(tree)
+        found = []
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute):
+                owner = node.value.id if isinstance(node.value, ast.Name) else None
+                if owner not in ("self", "cls") and (node.attr not in own or isinstance(node.ctx, ast.Store)):
+                    found.append((node.lineno, node.attr))
+            elif isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id in (
+                    "getattr", "setattr", "hasattr") and len(node.args) >= 2 and isinstance(node.args[1], ast.Constant):
+                owner = node.args[0].id if isinstance(node.args[0], ast.Name) else None
+                if owner not in ("self", "cls") and isinstance(node.args[1].value, str):
+                    found.append((node.lineno, node.args[1].value))
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                found += [(node.lineno, a.name) for a in node.names]
+        for line, name in found:
+            private = name.startswith("_") and not name.startswith("__") and not MANGLED.match(name)
+            if private and name not in PUBLIC_UNDERSCORE and (_relative(path), name) not in PENDING_PRIVATE_READS:
+                problems.append(f"{_relative(path)}:{line}: {name}")
+    assert not problems, "private names of other modules or packages:\n" + "\n".join(problems)

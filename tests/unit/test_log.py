@@ -300,3 +300,42 @@ def test_sumo_frames_handed_to_the_writer_thread_are_all_written_in_order(tmp_pa
     got = [m for _, m in iter_messages(path, [TOPIC_TRAFFIC])]
     assert [m["t"] for m in got] == [f.t for f in frames]
     assert [m["x"] for m in got] == [[f.x[0]] for f in frames]
+
+
+def test_the_bulk_writer_reaches_mcaps_chunk_state_and_writes_the_bytes_of_its_public_api(monkeypatch):
+    """The one read of mcap's private state (``cosim.log.writer._mcap_chunk_state``) still finds it, and the bulk
+    path built on it writes the bytes mcap's public ``add_message`` writes: if mcap's internals change, this
+    fails, rather than logging silently falling back to the slow path (or writing other bytes)."""
+    import io
+
+    from mcap.writer import CompressionType, Writer
+
+    from cosim.log.writer import _BulkWriter, _mcap_chunk_state
+
+    assert _mcap_chunk_state(Writer(io.BytesIO(), chunk_size=4096)) is not None, (
+        "mcap's Writer no longer keeps its chunk state where cosim.log.writer._mcap_chunk_state reads it")
+    rng = np.random.default_rng(7)
+    datas = [bytes(rng.integers(0, 256, int(rng.integers(1, 600)), dtype=np.uint8)) for _ in range(600)]
+    times = sorted(int(t) for t in rng.integers(0, 10**12, len(datas)))
+    files = []
+    for bulk in (False, True):
+        out = io.BytesIO()
+        writer = (_BulkWriter if bulk else Writer)(out, chunk_size=4096, compression=CompressionType.ZSTD,
+                                                   enable_data_crcs=True)
+        if bulk:  # the bulk path must not need add_message
+            monkeypatch.setattr(writer, "add_message", lambda *args, **kwargs: pytest.fail("fell back"))
+        writer.start(profile="cosim", library="test")
+        schema = writer.register_schema("s", "jsonschema", b"{}")
+        channels = [writer.register_channel(topic, "json", schema) for topic in ("/a", "/b")]
+        sequence = 0
+        for k in range(0, len(datas), 50):
+            for channel in channels:
+                if bulk:
+                    sequence = writer.add_encoded(channel, times[k:k + 50], datas[k:k + 50], sequence)
+                else:
+                    for t, data in zip(times[k:k + 50], datas[k:k + 50]):
+                        sequence += 1
+                        writer.add_message(channel, t, data, t, sequence)
+        writer.finish()
+        files.append(out.getvalue())
+    assert files[0] == files[1]
