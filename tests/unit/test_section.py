@@ -15,7 +15,6 @@ from cosim.core.section import (
     SectionProperties,
     section_from_constants,
     section_from_plates,
-    thin_walled_properties,
 )
 from cosim.errors import ConfigError, ModelError
 from cosim.validation.references import (
@@ -23,6 +22,7 @@ from cosim.validation.references import (
     i_section_warping_shear_constant,
     rectangle_torsion_constant,
 )
+from cosim.validation.thin_walled import thin_walled_properties
 
 # Exact integrals of a polygon: only round-off and the FE quadrature remain.
 EXACT_REL = 1e-6
