@@ -11,11 +11,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, Strict, ValidationError, model_validator
+from pydantic import Field, PlainValidator, Strict, model_validator
 
 from cosim.core.element import DOF_NAMES
 from cosim.errors import ConfigError
-from cosim.run.config_base import ConfigModel, choices_message, config_error, fail
+from cosim.run.config_base import ConfigModel, choices_message, fail, load_config
 from cosim.run.scenario import Scenario, list_bundled_scenarios, load_scenario
 
 from .sensor_models import SENSOR_TYPES
@@ -153,14 +153,7 @@ def parse_dataset(text: str, source: str = "<dataset>", base_dir: str | os.PathL
     Raises:
         ConfigError: the file is malformed or does not fit its base scenario (the message names the file and key).
     """
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
-    try:
-        parsed = DatasetFile.model_validate(raw)
-    except ValidationError as exc:
-        raise config_error(source, DatasetFile, exc) from None
+    parsed = load_config(text, source, DatasetFile)
     sec = parsed.dataset
     base_path = Path(base_dir) / sec.base
     try:

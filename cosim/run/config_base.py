@@ -7,16 +7,18 @@ that turns pydantic's errors into cosim's one-line messages::
 
 with "did you mean" for misspelled keys and choices. Files build their tables
 on :class:`ConfigModel` and raise :class:`Problems` (via :func:`fail`) from
-validators; :func:`config_error` formats a ``ValidationError`` for a file.
+validators; :func:`config_error` formats a ``ValidationError`` for a file, and
+:func:`load_config` reads a file's TOML and validates it in one call.
 """
 from __future__ import annotations
 
 import difflib
 import json
 import math
+import sys
 import types
-from collections.abc import Sequence
-from typing import Annotated, Any, Union, get_args, get_origin
+from collections.abc import Mapping, Sequence
+from typing import Annotated, Any, TypeVar, Union, get_args, get_origin, overload
 
 from pydantic import (
     BaseModel,
@@ -27,7 +29,12 @@ from pydantic import (
     ValidationError,
 )
 
-from cosim.errors import ConfigError
+from cosim.errors import ConfigError, CosimError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 #: Top-level sections that later versions add; rejected for now with a clear note.
 FUTURE_SECTIONS: dict[str, str] = {}
@@ -257,6 +264,54 @@ def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> Co
         more = len(lines) - 1
         lines.insert(1, f"({more} more problem{'s' if more > 1 else ''}:)")
     return ConfigError("\n".join(lines))
+
+
+M = TypeVar("M", bound=BaseModel)
+
+
+@overload
+def load_config(document: str | Mapping[str, Any], source: str, model: None = None, *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> dict[str, Any]: ...
+
+
+@overload
+def load_config(document: str | Mapping[str, Any], source: str, model: type[M], *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> M: ...
+
+
+def load_config(document: str | Mapping[str, Any], source: str, model: type[M] | None = None, *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> M | dict[str, Any]:
+    """A TOML document's tables, validated as ``model`` when one is given: the one TOML-to-config loader.
+
+    Scenarios, studies and datasets read their files through it, and so do a
+    replay (the scenario a log embeds) and ``cosim.testing`` (TOML text as a base).
+
+    Args:
+        document: TOML text, or the tables already read from it (then only validated).
+        source: how messages name the document: the file's path, ``"<scenario>"``, ...
+        model: the file's :class:`ConfigModel`; None returns the tables as read.
+        context: pydantic's validation context, for validators that need the file
+            (the scenario's source, text and folder).
+        error: what a TOML syntax error raises: :class:`ConfigError`, or
+            :class:`~cosim.errors.LogError` for the scenario a log embeds (a damaged log).
+
+    Raises:
+        ConfigError: ``<source>: TOML syntax error: <what> (at line L, column C)`` (as ``error``),
+            or the model's problems, one line per key (:func:`config_error`).
+    """
+    if isinstance(document, str):
+        try:
+            data = tomllib.loads(document)
+        except tomllib.TOMLDecodeError as exc:
+            raise error(f"{source}: TOML syntax error: {exc}") from None
+    else:
+        data = dict(document)
+    if model is None:
+        return data
+    try:
+        return model.model_validate(data, context=context)
+    except ValidationError as exc:
+        raise config_error(source, model, exc) from None
 
 
 # --------------------------------------------------------------------------- field types

@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, Strict, ValidationError, field_validator
+from pydantic import Field, PlainValidator, Strict, field_validator
 
 from cosim.core.limits import MAX_RUNS
 from cosim.core.roughness import ISO_CLASSES as ISO_ROAD_CLASSES
 from cosim.errors import ConfigError, CosimError
-from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
+from cosim.run.config_base import ConfigModel, Problems, choices_message, fail, load_config, show
 from cosim.run.scenario import ROAD_CLASSES, SUMO_LEVELS, Scenario, list_bundled_scenarios, load_scenario
 from cosim.run.tables import SensorConfig
 from cosim.study.folder import RUNS_FOLDER, SUMO_FOLDER
@@ -411,14 +411,8 @@ def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[
             read, or an axis does not fit the base scenario (e.g. ``vehicles_per_hour`` without
             SUMO traffic). Messages name the file and the key.
     """
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
-    try:
-        parsed = StudyFile.model_validate(raw)
-    except ValidationError as exc:
-        raise config_error(source, StudyFile, exc) from None
+    raw = load_config(text, source)  # its [[sensors]] tables join each run's scenario as written
+    parsed = load_config(raw, source, StudyFile)
     study_dir = Path(base_dir)
     sec = parsed.study
     base_path = study_dir / sec.base
