@@ -322,6 +322,8 @@ Positive = Annotated[float, Strict(), Field(gt=0)]
 NonNegative = Annotated[float, Strict(), Field(ge=0)]
 PositiveInt = Annotated[int, Strict(), Field(ge=1)]
 Text = Annotated[str, Strict()]
+Name = Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
+"""A name that can be part of a file name or a run id (a mismatch's message lists the characters allowed)."""
 
 
 def number_pair(value: Any, names: str) -> tuple[float, float]:
@@ -345,7 +347,9 @@ NetPoint = Annotated[tuple[float, float], PlainValidator(lambda v: number_pair(v
 """A point (x, y) in SUMO network coordinates, m."""
 
 
-def choice(choices: tuple[str, ...], what: str):  # noqa: ANN202 - returns a validator
+def choice(choices: tuple[str, ...], what: str) -> PlainValidator:
+    """A validator (``Annotated[str, choice(...)]``): one of ``choices``, else "unknown <what> ...", with a hint."""
+
     def check(value: Any) -> str:
         if not isinstance(value, str) or value not in choices:
             raise fail(choices_message(value, choices, what))
