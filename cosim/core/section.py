@@ -18,6 +18,7 @@ import numpy as np
 
 from cosim.errors import ConfigError, ModelError
 
+from .checks import finite
 from .limits import MAX_SECTION_TRIANGLES
 
 
@@ -215,17 +216,6 @@ class SectionField:
 # Input validation
 # ---------------------------------------------------------------------------
 
-def _finite(value: object, name: str, where: str = "") -> float:
-    """Return ``value`` as a float, or raise ConfigError naming ``name``."""
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}`{name}` must be a number (got {value!r})") from None
-    if not math.isfinite(number):
-        raise ConfigError(f"{where}`{name}` must be finite (got {value!r})")
-    return number
-
-
 def _point(value: object, name: str, where: str) -> tuple[float, float]:
     y: object
     z: object
@@ -233,7 +223,7 @@ def _point(value: object, name: str, where: str) -> tuple[float, float]:
         y, z = value  # type: ignore[misc]
     except (TypeError, ValueError):
         raise ConfigError(f"{where}`{name}` must be a (y, z) pair in m (got {value!r})") from None
-    return _finite(y, f"{name}[0]", where), _finite(z, f"{name}[1]", where)
+    return finite(y, f"{name}[0]", where), finite(z, f"{name}[1]", where)
 
 
 def validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float, float, float]]:
@@ -253,7 +243,7 @@ def validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float,
             raise ConfigError(f"{where}expected a Plate(start, end, thickness) (got {plate!r})")
         y1, z1 = _point(plate.start, "start", where)
         y2, z2 = _point(plate.end, "end", where)
-        t = _finite(plate.thickness, "thickness", where)
+        t = finite(plate.thickness, "thickness", where)
         if not t > 0:
             raise ConfigError(f"{where}`thickness` must be > 0 (got {plate.thickness!r})")
         length = math.hypot(y2 - y1, z2 - z1)
@@ -266,7 +256,7 @@ def validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float,
 
 
 def _check_nu(nu: float) -> float:
-    nu = _finite(nu, "nu")
+    nu = finite(nu, "nu")
     # Isotropic stability bounds; the shear functions of the FE solver need them.
     if not -1.0 < nu < 0.5:
         raise ConfigError(f"`nu` must lie in (-1, 0.5) (got {nu!r})")
@@ -357,7 +347,7 @@ def section_from_plates(
     if mesh_size is None:
         mesh_size = default_mesh_size(plates)
     else:
-        mesh_size = _finite(mesh_size, "mesh_size")
+        mesh_size = finite(mesh_size, "mesh_size")
         if not mesh_size > 0:
             raise ConfigError(f"`mesh_size` must be > 0 m^2 (got {mesh_size!r})")
     # Bounded before meshing: the mesher and solver allocate per triangle (1e-5 m^2 on a deck: MemoryError).
@@ -647,16 +637,16 @@ def section_from_constants(
         ConfigError: a value is missing, not finite or non-physical; the message
             names the key in backticks.
     """
-    A = _finite(A, "A")
-    I_y = _finite(I_y, "I_y")
-    I_z = _finite(I_z, "I_z")
-    J = _finite(J, "J")
+    A = finite(A, "A")
+    I_y = finite(I_y, "I_y")
+    I_z = finite(I_z, "I_z")
+    J = finite(J, "J")
     for name, value in (("A", A), ("I_y", I_y), ("I_z", I_z), ("J", J)):
         if not value > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {value!r})")
-    y_c = _finite(y_c, "y_c")
-    z_c = _finite(z_c, "z_c")
-    I_yz = _finite(I_yz, "I_yz")
+    y_c = finite(y_c, "y_c")
+    z_c = finite(z_c, "z_c")
+    I_yz = finite(I_yz, "I_yz")
     # Positive definiteness of the centroidal inertia tensor: otherwise one
     # principal second moment is <= 0 and the bending stiffness is singular.
     if not I_y * I_z > I_yz**2:
@@ -664,25 +654,25 @@ def section_from_constants(
             f"`I_yz` = {I_yz!r} m^4 is too large: I_y * I_z must exceed I_yz^2 "
             f"(I_y = {I_y!r}, I_z = {I_z!r}), or a principal second moment is <= 0"
         )
-    y_sc: float = y_c if y_s is None else _finite(y_s, "y_s")
-    z_sc: float = z_c if z_s is None else _finite(z_s, "z_s")
-    I_w = _finite(I_w, "I_w")
+    y_sc: float = y_c if y_s is None else finite(y_s, "y_s")
+    z_sc: float = z_c if z_s is None else finite(z_s, "z_s")
+    I_w = finite(I_w, "I_w")
     if not I_w >= 0:
         raise ConfigError(f"`I_w` must be >= 0 (got {I_w!r})")
     shear: dict[str, float] = {}
     given: tuple[tuple[str, float | None], ...] = (("A_sy", A_sy), ("A_sz", A_sz))
     for name, area in given:
-        shear[name] = 5.0 / 6.0 * A if area is None else _finite(area, name)
+        shear[name] = 5.0 / 6.0 * A if area is None else finite(area, name)
         if not shear[name] > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {area!r})")
     i_ws: float | None = None
     if I_ws is not None:
-        i_ws = _finite(I_ws, "I_ws")
+        i_ws = finite(I_ws, "I_ws")
         if not i_ws > 0:
             raise ConfigError(f"`I_ws` must be > 0 m^4 (got {I_ws!r})")
     mass: float | None = None
     if mass_per_length is not None:
-        mass = _finite(mass_per_length, "mass_per_length")
+        mass = finite(mass_per_length, "mass_per_length")
         if not mass > 0:
             raise ConfigError(f"`mass_per_length` must be > 0 kg/m (got {mass_per_length!r})")
     if not isinstance(rotary_inertia, bool):
