@@ -31,6 +31,11 @@ from pydantic import (
 
 from cosim.errors import ConfigError, CosimError
 
+# cosim's one number formatter: "500", "0.1", "-0.3333333333333333", the shortest text that reads back as the same
+# number (repr), not %.6g. It writes SUMO files and run ids, which must be exact, and the numbers of messages, where
+# a rounded bound can contradict its message ("must be <= 166.667 Hz (got 166.6667)" for 1 / 0.006 s).
+from cosim.sumo.files import number_text
+
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover - Python 3.10
@@ -52,14 +57,6 @@ class Problems(ValueError):
 
 def fail(message: str, *loc: str | int) -> Problems:
     return Problems([(tuple(loc), message)])
-
-
-def number_text(value: float) -> str:
-    """A bound for messages: 0 rather than 0.0, -0.333333 rather than 16 digits."""
-    value = float(value)
-    if value.is_integer():
-        return str(int(value))
-    return f"{value:.6g}"
 
 
 def show(value: Any, limit: int = 60) -> str:

@@ -64,6 +64,7 @@ from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.errors import ConfigError, ModelError
+from cosim.sumo.files import number_text
 
 from .bridge_tables import (
     MODE_KINDS,
@@ -80,7 +81,6 @@ from .config_base import (
     Text,
     fail,
     load_config,
-    number_text,
     show,
     suggest,
 )
