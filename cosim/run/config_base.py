@@ -263,7 +263,7 @@ def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> Co
     return ConfigError("\n".join(lines))
 
 
-M = TypeVar("M", bound=BaseModel)
+_Model = TypeVar("_Model", bound=BaseModel)
 
 
 @overload
@@ -272,12 +272,14 @@ def load_config(document: str | Mapping[str, Any], source: str, model: None = No
 
 
 @overload
-def load_config(document: str | Mapping[str, Any], source: str, model: type[M], *,
-                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> M: ...
+def load_config(document: str | Mapping[str, Any], source: str, model: type[_Model], *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> _Model: ...
 
 
-def load_config(document: str | Mapping[str, Any], source: str, model: type[M] | None = None, *,
-                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> M | dict[str, Any]:
+def load_config(
+    document: str | Mapping[str, Any], source: str, model: type[_Model] | None = None, *,
+    context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError,
+) -> _Model | dict[str, Any]:
     """A TOML document's tables, validated as ``model`` when one is given: the one TOML-to-config loader.
 
     Scenarios, studies and datasets read their files through it, and so do a
