@@ -53,6 +53,7 @@ from cosim.core.bridge import BridgeModel
 from cosim.core.fields import VEHICLE_NUMBERS
 from cosim.core.quasistatic import QuasiStaticResult, quasi_static
 from cosim.errors import ConfigError
+from cosim.run.config_base import load_config
 from cosim.run.scenario import Scenario, load_scenario, parse_scenario
 
 if sys.version_info >= (3, 11):
@@ -119,10 +120,7 @@ def _base(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None
         return _merge({}, base), "<test scenario>", Path.cwd()
     text = os.fspath(base)
     if "\n" in text or "[" in text:  # TOML text rather than a path or a bundled name
-        try:
-            return tomllib.loads(text), "<test scenario>", Path.cwd()
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"<test scenario>: TOML syntax error: {exc}") from None
+        return load_config(text, "<test scenario>"), "<test scenario>", Path.cwd()
     loaded = load_scenario(text)
     return tomllib.loads(loaded.text), loaded.source, loaded.base_dir
 

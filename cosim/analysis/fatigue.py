@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from cosim.core.checks import finite
 from cosim.errors import ConfigError
 
 __all__ = [
@@ -86,10 +87,7 @@ class SNCurve:
 
     def __post_init__(self) -> None:
         for key in ("ds_ref", "n_ref", "m1", "m2", "n_knee", "partial_factor"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
-                    or not value > 0:
-                raise ConfigError(f"S-N curve {self.name}: `{key}` must be a finite number > 0 (got {value!r})")
+            finite(getattr(self, key), key, f"S-N curve {self.name}: ", above=0.0)
         if self.n_cutoff is not None and not (math.isfinite(self.n_cutoff) and self.n_cutoff > self.n_knee):
             raise ConfigError(f"S-N curve {self.name}: `n_cutoff` must be finite and > n_knee = {self.n_knee:g} "
                               f"(got {self.n_cutoff!r})")

@@ -60,8 +60,7 @@ from functools import lru_cache
 import numpy as np
 import numpy.typing as npt
 
-from cosim.errors import ConfigError
-
+from .checks import one_of
 from .section import Material, SectionProperties
 
 DOF_NAMES: tuple[str, ...] = ("u", "v", "w", "theta_x", "theta_y", "theta_z", "psi")
@@ -110,10 +109,8 @@ class BeamTheory:
     bending: str = "timoshenko"
 
     def __post_init__(self) -> None:
-        for key, value, choices in (("torsion", self.torsion, TORSION_THEORIES),
-                                    ("bending", self.bending, BENDING_THEORIES)):
-            if value not in choices:
-                raise ConfigError(f"`{key}` must be one of {', '.join(repr(c) for c in choices)} (got {value!r})")
+        one_of(self.torsion, TORSION_THEORIES, "torsion")
+        one_of(self.bending, BENDING_THEORIES, "bending")
 
     @property
     def is_default(self) -> bool:

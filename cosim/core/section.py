@@ -18,6 +18,7 @@ import numpy as np
 
 from cosim.errors import ConfigError, ModelError
 
+from .checks import finite
 from .limits import MAX_SECTION_TRIANGLES
 
 
@@ -215,17 +216,6 @@ class SectionField:
 # Input validation
 # ---------------------------------------------------------------------------
 
-def _finite(value: object, name: str, where: str = "") -> float:
-    """Return ``value`` as a float, or raise ConfigError naming ``name``."""
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}`{name}` must be a number (got {value!r})") from None
-    if not math.isfinite(number):
-        raise ConfigError(f"{where}`{name}` must be finite (got {value!r})")
-    return number
-
-
 def _point(value: object, name: str, where: str) -> tuple[float, float]:
     y: object
     z: object
@@ -233,10 +223,10 @@ def _point(value: object, name: str, where: str) -> tuple[float, float]:
         y, z = value  # type: ignore[misc]
     except (TypeError, ValueError):
         raise ConfigError(f"{where}`{name}` must be a (y, z) pair in m (got {value!r})") from None
-    return _finite(y, f"{name}[0]", where), _finite(z, f"{name}[1]", where)
+    return finite(y, f"{name}[0]", where), finite(z, f"{name}[1]", where)
 
 
-def _validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float, float, float]]:
+def validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float, float, float]]:
     """Check every plate and lower it to ``(y1, z1, y2, z2, t)`` floats.
 
     Errors name the plate's index in ``plates`` so a user can find it in the
@@ -253,7 +243,7 @@ def _validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float
             raise ConfigError(f"{where}expected a Plate(start, end, thickness) (got {plate!r})")
         y1, z1 = _point(plate.start, "start", where)
         y2, z2 = _point(plate.end, "end", where)
-        t = _finite(plate.thickness, "thickness", where)
+        t = finite(plate.thickness, "thickness", where)
         if not t > 0:
             raise ConfigError(f"{where}`thickness` must be > 0 (got {plate.thickness!r})")
         length = math.hypot(y2 - y1, z2 - z1)
@@ -266,14 +256,14 @@ def _validated_plates(plates: Sequence[Plate]) -> list[tuple[float, float, float
 
 
 def _check_nu(nu: float) -> float:
-    nu = _finite(nu, "nu")
+    nu = finite(nu, "nu")
     # Isotropic stability bounds; the shear functions of the FE solver need them.
     if not -1.0 < nu < 0.5:
         raise ConfigError(f"`nu` must lie in (-1, 0.5) (got {nu!r})")
     return nu
 
 
-def _rectangle(y1: float, z1: float, y2: float, z2: float, t: float) -> list[tuple[float, float]]:
+def plate_rectangle(y1: float, z1: float, y2: float, z2: float, t: float) -> list[tuple[float, float]]:
     """Corners of the plate's rectangle: the midline offset by +-t/2, no end extension."""
     length = math.hypot(y2 - y1, z2 - z1)
     ny, nz = -(z2 - z1) / length * t / 2.0, (y2 - y1) / length * t / 2.0
@@ -307,7 +297,7 @@ def default_mesh_size(plates: Sequence[Plate]) -> float:
     Returns:
         ``min(t_min**2 / 8, A / 500)`` with ``A = sum(b t)``, m^2.
     """
-    rows = _validated_plates(plates)
+    rows = validated_plates(plates)
     t_min = min(r[4] for r in rows)
     area = sum(math.hypot(r[2] - r[0], r[3] - r[1]) * r[4] for r in rows)
     return min(_MESH_PER_T2 * t_min**2, _MESH_PER_AREA * area)
@@ -331,7 +321,7 @@ def section_from_plates(
     no extension at the ends) and thickness; the rectangles are merged into one
     polygon and meshed with quadratic triangles, and ``sectionproperties``
     solves the Saint-Venant torsion and flexure problems on it. Closed cells
-    are fine here (unlike :func:`thin_walled_properties`).
+    are fine here (unlike :func:`cosim.validation.thin_walled.thin_walled_properties`).
 
     The solve is cached per process: the same plates (in any order or
     direction), ``nu`` and ``mesh_size`` return the stored result without
@@ -351,13 +341,13 @@ def section_from_plates(
             are out of range.
         ModelError: the section solver fails on the geometry.
     """
-    rows = _validated_plates(plates)
+    rows = validated_plates(plates)
     nu = _check_nu(nu)
     given = mesh_size is not None
     if mesh_size is None:
         mesh_size = default_mesh_size(plates)
     else:
-        mesh_size = _finite(mesh_size, "mesh_size")
+        mesh_size = finite(mesh_size, "mesh_size")
         if not mesh_size > 0:
             raise ConfigError(f"`mesh_size` must be > 0 m^2 (got {mesh_size!r})")
     # Bounded before meshing: the mesher and solver allocate per triangle (1e-5 m^2 on a deck: MemoryError).
@@ -374,7 +364,7 @@ def _rectangles_and_union(rows: list[tuple[float, float, float, float, float]]) 
     from shapely.geometry import Polygon
     from shapely.ops import unary_union
 
-    rects = [Polygon(_rectangle(*r)) for r in rows]
+    rects = [Polygon(plate_rectangle(*r)) for r in rows]
     return rects, unary_union(rects)
 
 
@@ -499,8 +489,9 @@ def _section_field(section: Any, pole: tuple[float, float]) -> SectionField:
     return SectionField(nodes=nodes, elements=ids, omega=omega, solved=section)
 
 
-#: Below this share of I_ps^2 / A the warping constant is round-off (a section without warping): I_ws is infinite.
-_NO_WARPING = 1e-12
+#: Below this share of I_ps^2 / A the warping constant is round-off (a section without warping): I_ws is infinite
+#: (here and in the thin-walled formulas of :mod:`cosim.validation.thin_walled`).
+NO_WARPING = 1e-12
 
 
 def _tri6_gradients(coords: np.ndarray, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -551,7 +542,7 @@ def _warping_shear_constant(section: Any, pole: tuple[float, float], i_w: float,
     from sectionproperties.analysis.fea import gauss_points
 
     area = float(section.get_ea())
-    if not i_w > _NO_WARPING * i_ps**2 / area:
+    if not i_w > NO_WARPING * i_ps**2 / area:
         return math.inf
     cy, cz = (float(v) for v in section.get_c())
     coords = np.array([el.coords for el in section.elements], dtype=float)  # (n_el, 2, 6)
@@ -646,16 +637,16 @@ def section_from_constants(
         ConfigError: a value is missing, not finite or non-physical; the message
             names the key in backticks.
     """
-    A = _finite(A, "A")
-    I_y = _finite(I_y, "I_y")
-    I_z = _finite(I_z, "I_z")
-    J = _finite(J, "J")
+    A = finite(A, "A")
+    I_y = finite(I_y, "I_y")
+    I_z = finite(I_z, "I_z")
+    J = finite(J, "J")
     for name, value in (("A", A), ("I_y", I_y), ("I_z", I_z), ("J", J)):
         if not value > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {value!r})")
-    y_c = _finite(y_c, "y_c")
-    z_c = _finite(z_c, "z_c")
-    I_yz = _finite(I_yz, "I_yz")
+    y_c = finite(y_c, "y_c")
+    z_c = finite(z_c, "z_c")
+    I_yz = finite(I_yz, "I_yz")
     # Positive definiteness of the centroidal inertia tensor: otherwise one
     # principal second moment is <= 0 and the bending stiffness is singular.
     if not I_y * I_z > I_yz**2:
@@ -663,25 +654,25 @@ def section_from_constants(
             f"`I_yz` = {I_yz!r} m^4 is too large: I_y * I_z must exceed I_yz^2 "
             f"(I_y = {I_y!r}, I_z = {I_z!r}), or a principal second moment is <= 0"
         )
-    y_sc: float = y_c if y_s is None else _finite(y_s, "y_s")
-    z_sc: float = z_c if z_s is None else _finite(z_s, "z_s")
-    I_w = _finite(I_w, "I_w")
+    y_sc: float = y_c if y_s is None else finite(y_s, "y_s")
+    z_sc: float = z_c if z_s is None else finite(z_s, "z_s")
+    I_w = finite(I_w, "I_w")
     if not I_w >= 0:
         raise ConfigError(f"`I_w` must be >= 0 (got {I_w!r})")
     shear: dict[str, float] = {}
     given: tuple[tuple[str, float | None], ...] = (("A_sy", A_sy), ("A_sz", A_sz))
     for name, area in given:
-        shear[name] = 5.0 / 6.0 * A if area is None else _finite(area, name)
+        shear[name] = 5.0 / 6.0 * A if area is None else finite(area, name)
         if not shear[name] > 0:
             raise ConfigError(f"`{name}` must be > 0 (got {area!r})")
     i_ws: float | None = None
     if I_ws is not None:
-        i_ws = _finite(I_ws, "I_ws")
+        i_ws = finite(I_ws, "I_ws")
         if not i_ws > 0:
             raise ConfigError(f"`I_ws` must be > 0 m^4 (got {I_ws!r})")
     mass: float | None = None
     if mass_per_length is not None:
-        mass = _finite(mass_per_length, "mass_per_length")
+        mass = finite(mass_per_length, "mass_per_length")
         if not mass > 0:
             raise ConfigError(f"`mass_per_length` must be > 0 kg/m (got {mass_per_length!r})")
     if not isinstance(rotary_inertia, bool):
@@ -695,195 +686,4 @@ def section_from_constants(
         A=A, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_sc, z_s=z_sc, J=J, I_w=I_w,
         A_sy=shear["A_sy"], A_sz=shear["A_sz"], deck_y=(y_min, y_max), source=str(source),
         I_ws=i_ws, mass_per_length=mass, rotary_inertia=rotary_inertia,
-    )
-
-
-# ---------------------------------------------------------------------------
-# Classical open thin-walled theory (for comparison only)
-# ---------------------------------------------------------------------------
-
-# 3-point Gauss-Legendre on [0, 1]: exact for the quartic q(u)^2 of a plate
-# whose shear flow is quadratic.
-_GAUSS_U = 0.5 + 0.5 * np.array([-math.sqrt(0.6), 0.0, math.sqrt(0.6)])
-_GAUSS_W = np.array([5.0, 8.0, 5.0]) / 18.0
-
-
-def _plate_tree(
-    rows: list[tuple[float, float, float, float, float]],
-) -> tuple[np.ndarray, list[tuple[int, int, float]]]:
-    """Nodes and edges of the midline graph; plates are split at T-junctions.
-
-    A web whose end lies inside the deck's midline joins the deck there, so the
-    deck can be given as one plate.
-    """
-    ends = [(r[0], r[1]) for r in rows] + [(r[2], r[3]) for r in rows]
-    scale = max(max(abs(c) for p in ends for c in p), max(r[4] for r in rows))
-    tol = 1e-9 * scale
-    nodes: list[tuple[float, float]] = []
-
-    def node_of(p: tuple[float, float]) -> int:
-        for k, q in enumerate(nodes):
-            if math.hypot(p[0] - q[0], p[1] - q[1]) <= tol:
-                return k
-        nodes.append(p)
-        return len(nodes) - 1
-
-    plate_ends = [(node_of((r[0], r[1])), node_of((r[2], r[3])), r[4]) for r in rows]
-    edges: list[tuple[int, int, float]] = []
-    for (n1, n2, t) in plate_ends:
-        (y1, z1), (y2, z2) = nodes[n1], nodes[n2]
-        length2 = (y2 - y1) ** 2 + (z2 - z1) ** 2
-        inner = []
-        for k, (y, z) in enumerate(nodes):
-            if k in (n1, n2):
-                continue
-            u = ((y - y1) * (y2 - y1) + (z - z1) * (z2 - z1)) / length2
-            dist = abs((y - y1) * (z2 - z1) - (z - z1) * (y2 - y1)) / math.sqrt(length2)
-            if 0.0 < u < 1.0 and dist <= tol:
-                inner.append((u, k))
-        chain = [n1] + [k for _, k in sorted(inner)] + [n2]
-        edges.extend((a, b, t) for a, b in zip(chain[:-1], chain[1:]))
-    return np.array(nodes, dtype=float), edges
-
-
-def thin_walled_properties(plates: Sequence[Plate]) -> SectionProperties:
-    """Section constants of an open branched plate section by thin-walled theory.
-
-    Classical (Vlasov) formulas on the plate midlines: ``A = sum(b t)``; second
-    moments from the midlines plus each plate's own ``b t^3/12`` term;
-    ``J = sum(b t^3 / 3)``; shear centre and ``I_w`` from the sectorial
-    coordinate accumulated over the plate tree and normalised to the principal
-    sectorial coordinate; shear areas from the shear-flow energy
-    ``1 / A_s = integral of q^2 / t ds`` for a unit shear force, and the warping
-    shear constant ``I_ws = I_w^2 / integral of S_w^2 / t ds`` from the sectorial
-    flow ``S_w = integral of omega t ds`` (docs/theory.md §10.2). The shear
-    centre, ``I_w`` and the shear flows use midline second moments (no own
-    terms), as the closed-form textbook results do.
-
-    The model uses :func:`section_from_plates`; this function is for checking
-    it and for reports: it neglects the junction overlaps and the warping
-    across the thickness, which matter for thick plates.
-
-    Args:
-        plates: midline segments with thicknesses, m; midlines must meet at end
-            points or where an end point lies on another plate (a T-junction).
-
-    Returns:
-        The constants with ``source="thin-walled theory"``.
-
-    Raises:
-        ConfigError: a plate is invalid (the message names its index).
-        ModelError: the midlines form a closed cell or do not meet.
-    """
-    rows = _validated_plates(plates)
-    nodes, edges = _plate_tree(rows)
-    n_nodes = len(nodes)
-
-    adjacency: list[list[int]] = [[] for _ in range(n_nodes)]
-    for e, (a, b, _) in enumerate(edges):
-        adjacency[a].append(e)
-        adjacency[b].append(e)
-    # Breadth-first walk from node 0: each edge is stored as (edge, parent, child).
-    parent_edge = [-1] * n_nodes
-    seen = [False] * n_nodes
-    seen[0] = True
-    order: list[tuple[int, int, int]] = []
-    queue = [0]
-    closed = False
-    for node in queue:
-        for e in adjacency[node]:
-            if e == parent_edge[node]:
-                continue
-            a, b, _ = edges[e]
-            other = b if a == node else a
-            if seen[other]:
-                closed = True
-                continue
-            seen[other] = True
-            parent_edge[other] = e
-            order.append((e, node, other))
-            queue.append(other)
-    if not all(seen):
-        raise ModelError(
-            "plate midlines do not meet: the thin-walled formulas need plates joined at end points "
-            "or T-junctions; use the FE values (section_from_plates)"
-        )
-    if closed or len(edges) != n_nodes - 1:
-        raise ModelError("closed cells not supported by the thin-walled formulas; use the FE values")
-
-    y, z = nodes[:, 0], nodes[:, 1]
-    p1 = np.array([edges[e][0] for e, _, _ in order])
-    p2 = np.array([edges[e][1] for e, _, _ in order])
-    t = np.array([edges[e][2] for e, _, _ in order])
-    dy, dz = y[p2] - y[p1], z[p2] - z[p1]
-    b = np.hypot(dy, dz)
-    bt = b * t
-    area = float(bt.sum())
-    y_c = float((bt * (y[p1] + y[p2]) / 2).sum() / area)
-    z_c = float((bt * (z[p1] + z[p2]) / 2).sum() / area)
-    yt, zt = y - y_c, z - z_c
-
-    def integral(f: np.ndarray, g: np.ndarray, pa: np.ndarray, pb: np.ndarray) -> float:
-        """Integral of f g dA over the midlines for fields linear on each plate."""
-        return float((bt * (2 * f[pa] * g[pa] + f[pa] * g[pb] + f[pb] * g[pa] + 2 * f[pb] * g[pb]) / 6).sum())
-
-    iy_mid = integral(zt, zt, p1, p2)
-    iz_mid = integral(yt, yt, p1, p2)
-    iyz_mid = integral(yt, zt, p1, p2)
-    # Own terms across the thickness: a rectangle b x t rotated to direction (c, s).
-    c, s = dy / b, dz / b
-    own = bt * t**2 / 12
-    I_y = iy_mid + float((own * c**2).sum())
-    I_z = iz_mid + float((own * s**2).sum())
-    I_yz = iyz_mid - float((own * c * s).sum())
-
-    # Sectorial coordinate with the pole at the centroid, zero at node 0: on a
-    # straight plate the lever arm is constant, so omega is linear on each plate.
-    omega = np.zeros(n_nodes)
-    for _, parent, child in order:
-        lever = yt[parent] * (z[child] - z[parent]) - zt[parent] * (y[child] - y[parent])
-        omega[child] = omega[parent] + lever
-    # Moving the pole by (a, b) changes omega by -a z + b y; S is the pole for
-    # which the sectorial products with y and z vanish.
-    a_b = np.linalg.solve(
-        np.array([[iyz_mid, -iz_mid], [iy_mid, -iyz_mid]]),
-        np.array([integral(omega, yt, p1, p2), integral(omega, zt, p1, p2)]),
-    )
-    y_s, z_s = y_c + float(a_b[0]), z_c + float(a_b[1])
-    omega_s = omega - a_b[0] * zt + a_b[1] * yt
-    omega_s -= float((bt * (omega_s[p1] + omega_s[p2]) / 2).sum()) / area
-    I_w = max(integral(omega_s, omega_s, p1, p2), 0.0)
-
-    def shear_area(alpha: float, beta: float) -> float:
-        """1 / integral(q^2/t ds) for the shear flow of d(sigma)/dx = alpha y~ + beta z~."""
-        return flow_stiffness(alpha * yt + beta * zt)
-
-    def flow_stiffness(g: np.ndarray) -> float:
-        """1 / integral(q^2/t ds) for the shear flow q balancing d(sigma)/dx = g, g linear on each plate."""
-        below = np.zeros(n_nodes)  # integral of g dA over the subtree beyond each node
-        energy = 0.0
-        for k in range(len(order) - 1, -1, -1):
-            _, parent, child = order[k]
-            g1, g2 = g[parent], g[child]
-            u = _GAUSS_U
-            q = below[child] + bt[k] * (g1 * (1 - u) + (g2 - g1) * (1 - u**2) / 2)
-            energy += b[k] / t[k] * float((_GAUSS_W * q**2).sum())
-            below[parent] += below[child] + bt[k] * (g1 + g2) / 2
-        return 1.0 / energy
-
-    inertia = np.array([[iz_mid, iyz_mid], [iyz_mid, iy_mid]])
-    # Unit V_y: integral of g y~ dA = 1, of g z~ dA = 0 (and the reverse for V_z).
-    A_sy = shear_area(*np.linalg.solve(inertia, [1.0, 0.0]))
-    A_sz = shear_area(*np.linalg.solve(inertia, [0.0, 1.0]))
-    # Secondary torsion (docs/theory.md §10.2): the warping stress -E omega psi' is balanced by the flow
-    # q = (T_w / I_w) integral(omega t ds) from the free ends, whose energy defines I_ws = I_w^2 / integral(q^2/t ds).
-    i_ps = I_y + I_z + area * ((y_s - y_c) ** 2 + (z_s - z_c) ** 2)
-    I_ws = float(I_w**2 * flow_stiffness(omega_s)) if I_w > _NO_WARPING * i_ps**2 / area else math.inf
-
-    corners = np.array([pt for r in rows for pt in _rectangle(*r)])
-    return SectionProperties(
-        A=area, y_c=y_c, z_c=z_c, I_y=I_y, I_z=I_z, I_yz=I_yz, y_s=y_s, z_s=z_s,
-        J=float((bt * t**2 / 3).sum()), I_w=I_w, A_sy=A_sy, A_sz=A_sz,
-        deck_y=(float(corners[:, 0].min()), float(corners[:, 0].max())),
-        source="thin-walled theory", I_ws=I_ws,
     )

@@ -11,7 +11,6 @@ like any other channel.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +18,7 @@ import numpy as np
 from cosim.errors import ConfigError
 
 from .bridge import BridgeModel
+from .checks import finite, one_of
 from .element import DeckRow
 
 #: Sensor quantities and their SI units.
@@ -40,11 +40,6 @@ TIME_DERIVATIVE: dict[str, int] = {"displacement": 0, "velocity": 1, "accelerati
 SECTION_POINT_QUANTITIES: tuple[str, ...] = ("stress", "strain", "shear_stress_xy", "shear_stress_xz")
 #: Shear stress quantities: which component of (tau_xy, tau_xz).
 SHEAR_COMPONENT: dict[str, int] = {"shear_stress_xy": 0, "shear_stress_xz": 1}
-
-
-def _finite(name: str, key: str, value: object) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ConfigError(f"sensor {name}: `{key}` must be a finite number, m (got {value!r})")
 
 
 @dataclass(frozen=True)
@@ -84,15 +79,13 @@ class Sensor:
     def __post_init__(self) -> None:
         if isinstance(self.every, bool) or not isinstance(self.every, int) or self.every < 1:
             raise ConfigError(f"sensor {self.name}: `every` must be an integer >= 1 (got {self.every!r})")
-        if self.quantity not in SENSOR_QUANTITIES:
-            raise ConfigError(f"sensor {self.name}: `quantity` must be one of {', '.join(SENSOR_QUANTITIES)} "
-                              f"(got {self.quantity!r})")
+        one_of(self.quantity, SENSOR_QUANTITIES, "quantity", f"sensor {self.name}: ")
         for key in ("x", "y"):
-            _finite(self.name, key, getattr(self, key))
+            finite(getattr(self, key), key, f"sensor {self.name}: ", unit="m")
         for key in ("z", "omega"):
             value = getattr(self, key)
             if value is not None:
-                _finite(self.name, key, value)
+                finite(value, key, f"sensor {self.name}: ", unit="m")
         if self.on_section:
             if self.z is None:
                 raise ConfigError(f"sensor {self.name}: quantity = {self.quantity!r} is read at a point (y, z) of "

@@ -12,14 +12,13 @@ from __future__ import annotations
 
 import collections
 import csv
-import math
 import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -28,6 +27,7 @@ from cosim.errors import ConfigError
 
 from .bases import make_basis
 from .bridge import BridgeModel
+from .checks import finite, one_of
 from .coupling import BlockReport, CoupledSystem
 from .fields import VEHICLE_NUMBERS
 from .jit import compiled
@@ -48,14 +48,6 @@ JOINED_STEPS = 2000
 VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
 
-def _finite(owner: str, key: str, value: Any, low: float, inclusive: bool = False) -> None:
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and (
-        value >= low if inclusive else value > low)
-    if not ok:
-        raise ConfigError(f"{owner}`{key}` must be a finite number {'>=' if inclusive else '>'} {low:g} "
-                          f"(got {value!r})")
-
-
 @dataclass(frozen=True)
 class SolverSettings:
     """Time step (s), scheme (newmark | hht), basis (direct | modal) and modal truncation; gravity, m/s^2.
@@ -73,17 +65,15 @@ class SolverSettings:
     gravity: float = 9.81
 
     def __post_init__(self) -> None:
-        _finite("", "dt", self.dt, 0.0)
-        _finite("", "gravity", self.gravity, 0.0, inclusive=True)
-        if self.scheme not in SCHEMES:
-            raise ConfigError(f"`scheme` must be one of {', '.join(SCHEMES)} (got {self.scheme!r})")
-        if self.basis not in BASES:
-            raise ConfigError(f"`basis` must be one of {', '.join(BASES)} (got {self.basis!r})")
+        finite(self.dt, "dt", above=0.0)
+        finite(self.gravity, "gravity", at_least=0.0)
+        one_of(self.scheme, SCHEMES, "scheme")
+        one_of(self.basis, BASES, "basis")
         if self.modes is not None and (isinstance(self.modes, bool) or not isinstance(self.modes, int)
                                        or self.modes < 1):
             raise ConfigError(f"`modes` must be an integer >= 1 (got {self.modes!r})")
         if self.cutoff_hz is not None:
-            _finite("", "cutoff_hz", self.cutoff_hz, 0.0)
+            finite(self.cutoff_hz, "cutoff_hz", above=0.0)
 
     def make_scheme(self) -> Scheme:
         """The :class:`~cosim.core.schemes.Scheme` named by ``scheme``."""
@@ -341,7 +331,7 @@ def simulate(
             in one call of at most :data:`JOINED_STEPS` steps: each call costs the solver thread, the
             observers and the log a fixed amount of Python. The numbers are the same to the bit.
     """
-    _finite("", "duration", duration, 0.0)
+    finite(duration, "duration", above=0.0)
     if duration < solver.dt:
         raise ConfigError(f"`duration` must be at least one time step, dt = {solver.dt:g} s (got {duration!r})")
     if isinstance(output_every, bool) or not isinstance(output_every, int) or output_every < 1:

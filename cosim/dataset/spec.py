@@ -11,11 +11,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, Strict, ValidationError, model_validator
+from pydantic import Field, Strict, model_validator
 
 from cosim.core.element import DOF_NAMES
 from cosim.errors import ConfigError
-from cosim.run.config_base import ConfigModel, choices_message, config_error, fail
+from cosim.run.config_base import ConfigModel, Name, NonNegative, Number, Positive, choice, fail, load_config
 from cosim.run.scenario import Scenario, list_bundled_scenarios, load_scenario
 
 from .sensor_models import SENSOR_TYPES
@@ -27,29 +27,17 @@ else:  # pragma: no cover - Python 3.10
 
 __all__ = ["Dataset", "DamageCase", "load_dataset", "parse_dataset"]
 
-_NAME = Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
-_Positive = Annotated[float, Strict(), Field(gt=0)]
-_NonNegative = Annotated[float, Strict(), Field(ge=0)]
-_Number = Annotated[float, Strict()]
-
-
-def _one_of(choices: tuple[str, ...], what: str):  # noqa: ANN202 - a validator
-    def check(value: Any) -> str:
-        if not isinstance(value, str) or value not in choices:
-            raise fail(choices_message(value, choices, what))
-        return value
-    return PlainValidator(check)
 
 
 class DatasetSection(ConfigModel):
     """``[dataset]``: the base scenario and the windows."""
 
-    name: _NAME | None = None
+    name: Name | None = None
     base: Annotated[str, Strict(), Field(min_length=1)]
-    window: _Positive
+    window: Positive
     windows: Annotated[int, Strict(), Field(ge=1, le=100000)]
-    spacing: _Positive = 3600.0
-    start: _NonNegative = 0.0
+    spacing: Positive = 3600.0
+    start: NonNegative = 0.0
     seed: Annotated[int, Strict(), Field(ge=0)] = 1
     output: Annotated[str, Strict(), Field(min_length=1)] | None = None
 
@@ -57,22 +45,22 @@ class DatasetSection(ConfigModel):
 class TemperatureSection(ConfigModel):
     """``[temperature]``: a daily cycle of the deck's temperature and how E follows it."""
 
-    mean: _Number = 10.0
-    amplitude: _NonNegative = 0.0
+    mean: Number = 10.0
+    amplitude: NonNegative = 0.0
     peak_hour: Annotated[float, Strict(), Field(ge=0, lt=24)] = 15.0
-    reference: _Number = 10.0
+    reference: Number = 10.0
     e_per_kelvin: Annotated[float, Strict(), Field(gt=-0.05, lt=0.05)] = -0.003
 
 
 class DamageConfig(ConfigModel):
     """``[[damage]]``: a damage state; none of the keys: healthy."""
 
-    name: _NAME
-    x: tuple[_Number, _Number] | None = None
+    name: Name
+    x: tuple[Number, Number] | None = None
     stiffness: Annotated[float, Strict(), Field(gt=0, le=1)] = 1.0
     support: Annotated[int, Strict(), Field(ge=0)] | None = None
-    dof: Annotated[str, _one_of(DOF_NAMES, "DOF")] = "w"
-    spring: _Positive | None = None
+    dof: Annotated[str, choice(DOF_NAMES, "DOF")] = "w"
+    spring: Positive | None = None
 
     @model_validator(mode="after")
     def _consistent(self) -> DamageConfig:
@@ -88,14 +76,14 @@ class DamageConfig(ConfigModel):
 class InstrumentConfig(ConfigModel):
     """``[[sensors]]``: an instrument on the deck."""
 
-    name: _NAME
-    type: Annotated[str, _one_of(tuple(SENSOR_TYPES), "sensor type")]
-    x: _Number
-    y: _Number = 0.0
-    z: _Number | None = None
-    rate_hz: _Positive
-    noise: _NonNegative = 0.0
-    resolution: _NonNegative = 0.0
+    name: Name
+    type: Annotated[str, choice(tuple(SENSOR_TYPES), "sensor type")]
+    x: Number
+    y: Number = 0.0
+    z: Number | None = None
+    rate_hz: Positive
+    noise: NonNegative = 0.0
+    resolution: NonNegative = 0.0
 
     @model_validator(mode="after")
     def _strain_point(self) -> InstrumentConfig:
@@ -153,14 +141,7 @@ def parse_dataset(text: str, source: str = "<dataset>", base_dir: str | os.PathL
     Raises:
         ConfigError: the file is malformed or does not fit its base scenario (the message names the file and key).
     """
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
-    try:
-        parsed = DatasetFile.model_validate(raw)
-    except ValidationError as exc:
-        raise config_error(source, DatasetFile, exc) from None
+    parsed = load_config(text, source, DatasetFile)
     sec = parsed.dataset
     base_path = Path(base_dir) / sec.base
     try:

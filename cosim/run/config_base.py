@@ -7,16 +7,18 @@ that turns pydantic's errors into cosim's one-line messages::
 
 with "did you mean" for misspelled keys and choices. Files build their tables
 on :class:`ConfigModel` and raise :class:`Problems` (via :func:`fail`) from
-validators; :func:`config_error` formats a ``ValidationError`` for a file.
+validators; :func:`config_error` formats a ``ValidationError`` for a file, and
+:func:`load_config` reads a file's TOML and validates it in one call.
 """
 from __future__ import annotations
 
 import difflib
 import json
 import math
+import sys
 import types
-from collections.abc import Sequence
-from typing import Annotated, Any, Union, get_args, get_origin
+from collections.abc import Mapping, Sequence
+from typing import Annotated, Any, TypeVar, Union, get_args, get_origin, overload
 
 from pydantic import (
     BaseModel,
@@ -27,7 +29,17 @@ from pydantic import (
     ValidationError,
 )
 
-from cosim.errors import ConfigError
+from cosim.errors import ConfigError, CosimError
+
+# cosim's one number formatter: "500", "0.1", "-0.3333333333333333", the shortest text that reads back as the same
+# number (repr), not %.6g. It writes SUMO files and run ids, which must be exact, and the numbers of messages, where
+# a rounded bound can contradict its message ("must be <= 166.667 Hz (got 166.6667)" for 1 / 0.006 s).
+from cosim.sumo.files import number_text
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
 
 #: Top-level sections that later versions add; rejected for now with a clear note.
 FUTURE_SECTIONS: dict[str, str] = {}
@@ -45,14 +57,6 @@ class Problems(ValueError):
 
 def fail(message: str, *loc: str | int) -> Problems:
     return Problems([(tuple(loc), message)])
-
-
-def number_text(value: float) -> str:
-    """A bound for messages: 0 rather than 0.0, -0.333333 rather than 16 digits."""
-    value = float(value)
-    if value.is_integer():
-        return str(int(value))
-    return f"{value:.6g}"
 
 
 def show(value: Any, limit: int = 60) -> str:
@@ -259,6 +263,56 @@ def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> Co
     return ConfigError("\n".join(lines))
 
 
+_Model = TypeVar("_Model", bound=BaseModel)
+
+
+@overload
+def load_config(document: str | Mapping[str, Any], source: str, model: None = None, *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> dict[str, Any]: ...
+
+
+@overload
+def load_config(document: str | Mapping[str, Any], source: str, model: type[_Model], *,
+                context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError) -> _Model: ...
+
+
+def load_config(
+    document: str | Mapping[str, Any], source: str, model: type[_Model] | None = None, *,
+    context: dict[str, Any] | None = None, error: type[CosimError] = ConfigError,
+) -> _Model | dict[str, Any]:
+    """A TOML document's tables, validated as ``model`` when one is given: the one TOML-to-config loader.
+
+    Scenarios, studies and datasets read their files through it, and so do a
+    replay (the scenario a log embeds) and ``cosim.testing`` (TOML text as a base).
+
+    Args:
+        document: TOML text, or the tables already read from it (then only validated).
+        source: how messages name the document: the file's path, ``"<scenario>"``, ...
+        model: the file's :class:`ConfigModel`; None returns the tables as read.
+        context: pydantic's validation context, for validators that need the file
+            (the scenario's source, text and folder).
+        error: what a TOML syntax error raises: :class:`ConfigError`, or
+            :class:`~cosim.errors.LogError` for the scenario a log embeds (a damaged log).
+
+    Raises:
+        ConfigError: ``<source>: TOML syntax error: <what> (at line L, column C)`` (as ``error``),
+            or the model's problems, one line per key (:func:`config_error`).
+    """
+    if isinstance(document, str):
+        try:
+            data = tomllib.loads(document)
+        except tomllib.TOMLDecodeError as exc:
+            raise error(f"{source}: TOML syntax error: {exc}") from None
+    else:
+        data = dict(document)
+    if model is None:
+        return data
+    try:
+        return model.model_validate(data, context=context)
+    except ValidationError as exc:
+        raise config_error(source, model, exc) from None
+
+
 # --------------------------------------------------------------------------- field types
 
 Number = Annotated[float, Strict()]
@@ -267,6 +321,8 @@ Positive = Annotated[float, Strict(), Field(gt=0)]
 NonNegative = Annotated[float, Strict(), Field(ge=0)]
 PositiveInt = Annotated[int, Strict(), Field(ge=1)]
 Text = Annotated[str, Strict()]
+Name = Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
+"""A name that can be part of a file name or a run id (a mismatch's message lists the characters allowed)."""
 
 
 def number_pair(value: Any, names: str) -> tuple[float, float]:
@@ -290,7 +346,9 @@ NetPoint = Annotated[tuple[float, float], PlainValidator(lambda v: number_pair(v
 """A point (x, y) in SUMO network coordinates, m."""
 
 
-def choice(choices: tuple[str, ...], what: str):  # noqa: ANN202 - returns a validator
+def choice(choices: tuple[str, ...], what: str) -> PlainValidator:
+    """A validator (``Annotated[str, choice(...)]``): one of ``choices``, else "unknown <what> ...", with a hint."""
+
     def check(value: Any) -> str:
         if not isinstance(value, str) or value not in choices:
             raise fail(choices_message(value, choices, what))

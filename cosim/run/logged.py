@@ -28,6 +28,7 @@ from cosim import __version__
 from cosim.analysis.fatigue import FatigueResult
 from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
+from cosim.core.checks import one_of
 from cosim.core.limits import MAX_STEPS
 from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
@@ -289,8 +290,7 @@ def run_logged(
     if not scenario.vehicles and scenario.traffic is None and traffic is None:
         raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
                           "nothing to simulate in time")
-    if writer not in LOG_WRITERS:
-        raise ConfigError(f"run_logged: `writer` must be one of {', '.join(LOG_WRITERS)} (got {writer!r})")
+    one_of(writer, LOG_WRITERS, "writer", "run_logged: ")
     writer_child = writer == "process" or (writer == "auto" and fork_possible())
     if writer_child and not fork_possible():
         raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "

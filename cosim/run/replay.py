@@ -24,6 +24,7 @@ from cosim.log.replay_source import LoggedTraffic
 from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.sumo.files import FILE_OPTIONS, read_config
 
+from .config_base import load_config
 from .inputs import input_files
 from .scenario import Scenario, parse_scenario
 from .toml_writer import get_key, set_key, toml_dumps
@@ -195,10 +196,7 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     overview = open_log(log)
     text = _scenario_text(overview)
     source = f"{overview.path} ({SCENARIO_ATTACHMENT})"
-    try:
-        logged = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise LogError(f"{source}: TOML syntax error: {exc}") from None
+    logged = load_config(text, source, error=LogError)  # not TOML: the log is damaged
     record = {"log": str(overview.path), "log_scenario": overview.info.get("scenario", ""),
               "log_started": overview.info.get("started", ""), "log_status": overview.status_word}
     sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "traffic" in logged

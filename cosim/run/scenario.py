@@ -38,7 +38,6 @@ import datetime
 import math
 import os
 import re
-import sys
 from collections.abc import Iterator
 from importlib import resources
 from pathlib import Path
@@ -49,7 +48,6 @@ from pydantic import (
     Field,
     PrivateAttr,
     Strict,
-    ValidationError,
     ValidationInfo,
     model_validator,
 )
@@ -66,6 +64,7 @@ from cosim.core.sensors import Sensor
 from cosim.core.simulation import SolverSettings
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.errors import ConfigError, ModelError
+from cosim.sumo.files import number_text
 
 from .bridge_tables import (
     MODE_KINDS,
@@ -80,9 +79,8 @@ from .config_base import (
     ConfigModel,
     Problems,
     Text,
-    config_error,
     fail,
-    number_text,
+    load_config,
     show,
     suggest,
 )
@@ -98,11 +96,6 @@ from .tables import (
     TrafficConfig,
     VehicleConfig,
 )
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10
-    import tomli as tomllib
 
 # The tables and names of the scenario file are part of its public face (cosim.run.scenario.X).
 __all__ = [
@@ -547,15 +540,8 @@ def parse_scenario(
     Raises:
         ConfigError: syntax error, unknown/missing key, wrong type or non-physical value.
     """
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
-    try:
-        context = {"source": source, "text": text, "base_dir": os.fspath(base_dir)}
-        return Scenario.model_validate(data, context=context)
-    except ValidationError as exc:
-        raise config_error(source, Scenario, exc) from None
+    context = {"source": source, "text": text, "base_dir": os.fspath(base_dir)}
+    return load_config(text, source, Scenario, context=context)
 
 
 def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:

@@ -26,6 +26,7 @@ from cosim.errors import ConfigError
 
 from .config_base import (
     ConfigModel,
+    Name,
     NetPoint,
     NonNegative,
     Number,
@@ -94,8 +95,6 @@ ROAD_CLASSES: tuple[str, ...] = (*ISO_CLASSES, "smooth")
 #: ``[traffic].sumo_config`` may name one of these bundled demand levels (sumo_networks/<level>.sumocfg).
 SUMO_LEVELS: tuple[str, ...] = ("light", "medium", "heavy", "congested")
 
-_NAME_PATTERN = r"^[A-Za-z0-9_.-]+$"
-
 DEFAULT_HHT_ALPHA = -0.05
 DEFAULT_MODAL_MODES = 30
 #: Default logging rate of ``[output]``, Hz (every step when dt is longer than its period).
@@ -138,7 +137,7 @@ def _sn_name(value: Any) -> str:
 class SensorConfig(ConfigModel):
     """``[[sensors]]``: a measured quantity at a deck point, or a stress or strain at a section point."""
 
-    name: Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
+    name: Name
     x: Number
     y: Number = 0.0
     z: Number | None = None
@@ -236,7 +235,7 @@ class AxleConfig(ConfigModel):
 class VehicleConfig(ConfigModel):
     """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
 
-    id: Annotated[str, Strict(), Field(pattern=_NAME_PATTERN)]
+    id: Name
     model: Annotated[str, choice(tuple(VEHICLE_MODELS), "vehicle model")]
     mass: Number | None = None
     m_v: Number | None = None

@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, Strict, ValidationError, field_validator
+from pydantic import Field, PlainValidator, Strict, field_validator
 
 from cosim.core.limits import MAX_RUNS
 from cosim.core.roughness import ISO_CLASSES as ISO_ROAD_CLASSES
 from cosim.errors import ConfigError, CosimError
-from cosim.run.config_base import ConfigModel, Problems, choices_message, config_error, fail, show
+from cosim.run.config_base import ConfigModel, Name, Positive, Problems, choice, fail, load_config, show
 from cosim.run.scenario import ROAD_CLASSES, SUMO_LEVELS, Scenario, list_bundled_scenarios, load_scenario
 from cosim.run.tables import SensorConfig
 from cosim.study.folder import RUNS_FOLDER, SUMO_FOLDER
@@ -82,17 +82,9 @@ ERROR_LIMIT = 2000
 
 # --------------------------------------------------------------------------- the study file
 
-_NAME = Annotated[str, Strict(), Field(pattern=r"^[A-Za-z0-9_.-]+$")]
 _Text = Annotated[str, Strict(), Field(min_length=1)]
-_Positive = Annotated[float, Strict(), Field(gt=0)]
 _Share = Annotated[float, Strict(), Field(ge=0.0, le=1.0)]
 _Percent = Annotated[float, Strict(), Field(gt=0.0, le=100.0)]
-
-
-def _road_class(value: Any) -> str:
-    if not isinstance(value, str) or value not in ROAD_CLASSES:
-        raise fail(choices_message(value, ROAD_CLASSES, "road class"))
-    return value
 
 
 def _seeds(value: Any) -> tuple[int, ...]:
@@ -119,9 +111,9 @@ def _seeds(value: Any) -> tuple[int, ...]:
 class StudySection(ConfigModel):
     """``[study]``: what to run and where the results go."""
 
-    name: _NAME | None = None
+    name: Name | None = None
     base: _Text
-    duration: _Positive | None = None
+    duration: Positive | None = None
     output: _Text | None = None
     percentiles: tuple[_Percent, ...] = DEFAULT_PERCENTILES
     plots: Annotated[bool, Strict()] = True
@@ -131,10 +123,10 @@ class SweepSection(ConfigModel):
     """``[sweep]``: the axes; every combination of their values is one run."""
 
     sumo_config: tuple[_Text, ...] | None = None
-    vehicles_per_hour: tuple[_Positive, ...] | None = None
+    vehicles_per_hour: tuple[Positive, ...] | None = None
     truck_share: tuple[_Share, ...] | None = None
-    speed_limit: tuple[_Positive, ...] | None = None
-    road_class: tuple[Annotated[str, PlainValidator(_road_class)], ...] | None = None
+    speed_limit: tuple[Positive, ...] | None = None
+    road_class: tuple[Annotated[str, choice(ROAD_CLASSES, "road class")], ...] | None = None
     seeds: Annotated[tuple[int, ...], PlainValidator(_seeds)] | None = None
 
     @field_validator("*")
@@ -155,7 +147,7 @@ class SweepSection(ConfigModel):
 class FatigueSection(ConfigModel):
     """``[fatigue]``: how a run's damage becomes a damage per year."""
 
-    vehicles_per_year: _Positive | None = None
+    vehicles_per_year: Positive | None = None
 
 
 #: Run statistics whose maxima over the seeds can be fitted: the largest value, the largest of -value, |value|.
@@ -166,18 +158,12 @@ class ExtremesSection(ConfigModel):
     """``[extremes]``: characteristic values from the maxima of the study's seeds (one block per run)."""
 
     sensors: tuple[_Text, ...] | None = None
-    statistic: Annotated[str, PlainValidator(lambda v: _one_of(v, tuple(EXTREME_STATISTICS), "statistic"))] = "max"
-    distribution: Annotated[str, PlainValidator(lambda v: _one_of(v, ("gumbel", "gev"), "distribution"))] = "gumbel"
-    return_period: _Positive = 1000.0
+    statistic: Annotated[str, choice(tuple(EXTREME_STATISTICS), "statistic")] = "max"
+    distribution: Annotated[str, choice(("gumbel", "gev"), "distribution")] = "gumbel"
+    return_period: Positive = 1000.0
     confidence: Annotated[float, Strict(), Field(gt=0.0, lt=1.0)] = 0.95
     bootstrap: Annotated[int, Strict(), Field(ge=10, le=10000)] = 200
     seed: Annotated[int, Strict(), Field(ge=0)] = 1
-
-
-def _one_of(value: Any, choices: tuple[str, ...], what: str) -> str:
-    if not isinstance(value, str) or value not in choices:
-        raise fail(choices_message(value, choices, what))
-    return value
 
 
 class StudyFile(ConfigModel):
@@ -411,14 +397,8 @@ def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[
             read, or an axis does not fit the base scenario (e.g. ``vehicles_per_hour`` without
             SUMO traffic). Messages name the file and the key.
     """
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{source}: TOML syntax error: {exc}") from None
-    try:
-        parsed = StudyFile.model_validate(raw)
-    except ValidationError as exc:
-        raise config_error(source, StudyFile, exc) from None
+    raw = load_config(text, source)  # its [[sensors]] tables join each run's scenario as written
+    parsed = load_config(raw, source, StudyFile)
     study_dir = Path(base_dir)
     sec = parsed.study
     base_path = study_dir / sec.base

@@ -1,6 +1,7 @@
 """``cosim validate``: verification cases against closed forms, the paper's validation case, and the report.
 
 - :mod:`~cosim.validation.references`: closed-form and independent reference solutions;
+- :mod:`~cosim.validation.thin_walled`: the classical thin-walled section constants, the FE section solver's check;
 - :mod:`~cosim.validation.cases`: the studies, computing only (frozen results, no drawing);
 - :mod:`~cosim.validation.registry`: the one list of studies with their quick and full settings,
   shared by ``cosim validate`` and ``tests/verification``;

@@ -122,7 +122,7 @@ WITH_IWS = replace(GENERAL, I_ws=0.8)  # m^4: phi_t = 12 E I_w / (G I_ws L^2) = 
 
 
 def test_the_theories_are_checked():
-    with pytest.raises(ConfigError, match="`torsion` must be one of 'vlasov', 'benscoter'"):
+    with pytest.raises(ConfigError, match="`torsion` must be one of vlasov, benscoter"):
         BeamTheory(torsion="timoshenko")
     with pytest.raises(ConfigError, match="`bending` must be one of"):
         BeamTheory(bending="rayleigh")

@@ -15,7 +15,6 @@ from cosim.core.section import (
     SectionProperties,
     section_from_constants,
     section_from_plates,
-    thin_walled_properties,
 )
 from cosim.errors import ConfigError, ModelError
 from cosim.validation.references import (
@@ -23,6 +22,7 @@ from cosim.validation.references import (
     i_section_warping_shear_constant,
     rectangle_torsion_constant,
 )
+from cosim.validation.thin_walled import thin_walled_properties
 
 # Exact integrals of a polygon: only round-off and the FE quadrature remain.
 EXACT_REL = 1e-6
@@ -249,7 +249,7 @@ def test_zero_length_plate_names_the_plate() -> None:
 def test_non_finite_coordinate_names_the_plate() -> None:
     plates = double_tee()
     plates[0] = Plate((-6.655, float("nan")), (6.655, 0.0), 0.25)
-    with pytest.raises(ConfigError, match=r"plate 0: `start\[1\]` must be finite"):
+    with pytest.raises(ConfigError, match=r"plate 0: `start\[1\]` must be a finite number \(got nan\)"):
         section_from_plates(plates)
 
 
@@ -298,7 +298,7 @@ def test_constants_defaults_and_validation() -> None:
         (dict(A_sz=0.0), "`A_sz` must be > 0"),
         (dict(deck_y=(6.0, -6.0)), "`deck_y` must be ordered"),
         (dict(deck_y=None), "`deck_y` is required"),
-        (dict(I_y=float("inf")), "`I_y` must be finite"),
+        (dict(I_y=float("inf")), "`I_y` must be a finite number \\(got inf\\)"),
         (dict(I_ws=0.0), "`I_ws` must be > 0 m\\^4"),
         (dict(mass_per_length=-1.0), "`mass_per_length` must be > 0 kg/m"),
         (dict(rotary_inertia=0), "`rotary_inertia` must be true or false"),

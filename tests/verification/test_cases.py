@@ -2,7 +2,7 @@
 
 The cases are the ones ``cosim validate`` reports (:data:`cosim.validation.STUDIES`,
 quick settings): each names its reference's source and its tolerance, stated
-with its reason at the top of :mod:`cosim.validation.cases`. The tests below
+with its reason in :mod:`cosim.validation.cases.common`. The tests below
 the first assert what else the same computed cases must show.
 """
 from __future__ import annotations
@@ -11,13 +11,13 @@ import pytest
 
 from cosim.validation import STUDIES, Study
 
-# Tolerances of the extra checks (the cases' own ones live in cosim.validation.cases).
+# Tolerances of the extra checks (the cases' own ones live in cosim.validation.cases.common).
 EXACT_POSITION_ABS = 1e-9  # m: the scripted stop at mid-span
 
 
 @pytest.mark.parametrize("study", STUDIES, ids=[s.name for s in STUDIES])
 def test_every_case_meets_its_tolerance(study: Study, computed) -> None:
-    # Source and tolerance: each case's `reference` and `tolerance` (cosim/validation/cases.py, TOL_*).
+    # Source and tolerance: each case's `reference` and `tolerance` (cosim/validation/cases/common.py, TOL_*).
     result = computed(study.name)
     assert result.cases, f"{study.name} computed no case"
     for case in result.cases:

@@ -16,10 +16,9 @@ are the HHT ``F_n`` of the vehicle). Parameters: a column of ``params``
 """
 from __future__ import annotations
 
-import math
 from typing import ClassVar
 
-from cosim.errors import ConfigError
+from ..checks import finite
 
 #: Rows of a vehicle's compiled state: body u, u', u''; wheel u, u', u''; suspension force; tyre force.
 STATE_ROWS = 8
@@ -34,15 +33,13 @@ MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR, LINEAR = 0, 1, 2, 3
 def check_positive(owner: str, **values: float) -> None:
     """Raise ConfigError unless every value is a finite number > 0 (``owner`` names the vehicle or model)."""
     for name, value in values.items():
-        if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise ConfigError(f"{owner}: `{name}` must be a finite number > 0 (got {value!r})")
+        finite(value, name, f"{owner}: ", above=0.0)
 
 
 def check_non_negative(owner: str, **values: float) -> None:
     """Raise ConfigError unless every value is a finite number >= 0."""
     for name, value in values.items():
-        if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-            raise ConfigError(f"{owner}: `{name}` must be a finite number >= 0 (got {value!r})")
+        finite(value, name, f"{owner}: ", at_least=0.0)
 
 
 class OneContact:
