@@ -1,4 +1,4 @@
-"""The layout is the architecture: these tests keep it true (README, "Project layout").
+"""The layout is the architecture: these tests keep it true (docs/architecture.md).
 
 Layers, from the bottom: ``cosim.errors``; the numerical core ``cosim.core``
 (numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo`` and
@@ -117,6 +117,19 @@ def test_no_module_imports_another_modules_private_names():
             private = [n for n in names if n.startswith("_") and not n.startswith("__")]
             if private:
                 problems.append(f"{module}:{line}: imports {', '.join(private)} from {target}")
+    assert not problems, "\n".join(problems)
+
+
+def test_only_the_command_line_prints():
+    """``print`` is called in ``cosim.cli`` only: the other layers return values, raise and report progress
+    through callbacks (docstring examples are not calls, so they do not count)."""
+    problems = []
+    for module, path in _modules().items():
+        if _part(module) == "cosim.cli":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "print":
+                problems.append(f"{module}:{node.lineno}: calls print (only cosim.cli prints)")
     assert not problems, "\n".join(problems)
 
 
