@@ -1,7 +1,7 @@
 """The verification and validation cases of ``cosim validate``: computing only.
 
-Every function here is one study of DESIGN.md section 8 -- the paper's 40 m
-double-tee bridge (``shared/cases/paper-double-tee.md``) or a closed-form or
+Every function here is one study of docs/validation.md -- the paper's 40 m
+double-tee bridge (the paper's validation case there) or a closed-form or
 independent reference of :mod:`cosim.validation.references` -- and returns a
 frozen :class:`~cosim.validation.results.StudyResult`: its cases (error,
 tolerance, the reference's source, the numbers behind the error) and the data
@@ -96,8 +96,8 @@ TOL_BENSCOTER_FREQ = 5e-4  # 40 elements, first three torsional modes (measured 
 TOL_VBI2D = 5e-3  # the issue's 0.5 % of VBI-2D's published peak
 TOL_VBI2D_PEAK_TIME = 0.005  # s: the peak's time against VBI-2D's (0.436 s), five steps of 1 ms
 
-# The paper's vehicles (Table 2 with the units of DESIGN.md section 9; wheel masses from
-# shared/cases/paper-double-tee.md) and its read-out points at mid-span, deck level.
+# The paper's vehicles (Table 2 with the units of docs/theory.md §3.7; wheel masses from
+# docs/validation.md) and its read-out points at mid-span, deck level.
 PAPER_QC1 = QuarterCar(m_v=1000.0, m_w=100.0, k_v=39478.40, c_v=5026.55)
 PAPER_QC2 = QuarterCar(m_v=2000.0, m_w=200.0, k_v=78956.80, c_v=10053.10)
 PAPER_LANE_Y = 3.325  # m
@@ -208,7 +208,7 @@ def _paper_runs(bridge: BridgeModel, dt: float, runs: Sequence[tuple[str, str, b
 
 def _paper_setup(bridge: BridgeModel, dt: float) -> str:
     return (
-        "Set-up (shared/cases/paper-double-tee.md): bundled scenario paper-double-tee "
+        "Set-up (docs/validation.md): bundled scenario paper-double-tee "
         f"({bridge.n_elements} elements, rigid ends, {bridge.damping_note}; alpha = {bridge.alpha:.6g} 1/s, "
         f"beta = {bridge.beta:.6g} s). QC-1 (m_v 1000 kg, m_w 100 kg, k_v 39478.40 N/m, c_v 5026.55 N s/m) enters "
         f"at t = 0, QC-2 (m_v 2000 kg, m_w 200 kg, k_v 78956.80 N/m, c_v 10053.10 N s/m) at {PAPER_QC2_ENTRY} s, "
@@ -230,7 +230,7 @@ def paper_case(dt: float) -> StudyResult:
     res = _paper_runs(bridge, dt, [("qc", "direct", False), ("qc_modal", "modal", False), ("mf", "direct", True)])
     reference = (
         "Direct (full FE) basis as the reference for the modal basis; the set-up of the source paper "
-        "(Figs. 4-6) as fixed by shared/cases/paper-double-tee.md"
+        "(Figs. 4-6) as fixed by docs/validation.md"
     )
     events = ((PAPER_QC2_ENTRY, "QC-2 on"), (bridge.length / PAPER_SPEED, "QC-1 off"),
               (PAPER_QC2_ENTRY + bridge.length / PAPER_SPEED, "QC-2 off"))
@@ -492,7 +492,7 @@ def torsional_frequencies() -> StudyResult:
     ref = torsional_frequencies_hz(np.arange(1, 4), L, STEEL, sec)
     return StudyResult((_frequency_case(
         "Torsional frequencies with warping",
-        "ω² = (GJ k² + E I_w k⁴) / (ρ I_p + ρ I_w k²), k = nπ/L, fork supports (Vlasov; DESIGN.md section 8)",
+        "ω² = (GJ k² + E I_w k⁴) / (ρ I_p + ρ I_w k²), k = nπ/L, fork supports (Vlasov; docs/theory.md §8)",
         fe, ref, [f"torsion {n}" for n in range(1, 4)],
         "Doubly symmetric I-like section (J = 1e-6 m4, I_w = 2e-6 m6), L = 10 m, 40 elements, fork supports.",
     ),))

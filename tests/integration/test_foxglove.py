@@ -1,7 +1,7 @@
 """Logs for Foxglove: the layout made for each run (``cosim layout``), the 3D scene of real runs (scripted
 and real SUMO), and logs written before either existed. Real runs, real MCAP files, the real command line.
 
-What Foxglove itself shows was checked with ../shared/tools/foxglove/view.sh (a real Foxglove in a real
+What Foxglove itself shows was checked with a script outside this repository (a real Foxglove in a real
 browser; docs/foxglove.md): that needs npm and a browser, so it is not run here. Here: the layout names
 only fields the log really has, and the scene's messages are what Foxglove's schemas describe.
 """
