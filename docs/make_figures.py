@@ -1,10 +1,10 @@
-"""Make the README's figures that no cosim command draws by itself (run on demand).
+"""Make the figures of the docs that no cosim command draws by itself (run on demand).
 
     python docs/make_figures.py
 
-- docs/img/replay.png: one logged run replayed onto another bridge
+- docs/img/replay.png (docs/cli.md): one logged run replayed onto another bridge
   (`cosim run` then `cosim replay --scenario`), the two sensor histories overlaid;
-- docs/img/drive-by.png: the drive-by example of the scenario tests, the
+- docs/img/drive-by.png (docs/studies.md): the drive-by example of the scenario tests, the
   probe car's body-acceleration spectrum against the bridge's first frequency.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Closed-form and independent reference solutions (DESIGN.md section 8).
+"""Closed-form and independent reference solutions (docs/theory.md §8, docs/validation.md).
 
 The one copy of every reference the verification tests (``tests/verification``)
 and ``cosim validate`` (:mod:`cosim.validation.cases`) compare the model with. Each
@@ -200,7 +200,7 @@ def torsional_frequencies_hz(
     """Torsional frequencies (Hz) with fork supports (warping free), S = C.
 
     ``omega^2 = (GJ k^2 + E I_w k^4) / (rho I_p + rho I_w k^2)``, ``k = n pi / L``
-    (Vlasov; DESIGN.md section 8), polar inertia about the shear centre.
+    (Vlasov; docs/theory.md §8), polar inertia about the shear centre.
     """
     E, G, rho = material.E, material.G, material.rho
     k = np.asarray(n, dtype=float) * np.pi / L

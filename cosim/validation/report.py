@@ -225,7 +225,7 @@ def report_markdown(cases: Sequence[CaseResult], quick: bool, wall: float, drawn
         "",
         "Each case compares the model with a reference named below; the error is measured as its metric says "
         "and must not exceed the tolerance. Sign convention: z up, deflections downward are negative. "
-        "Verification cases: DESIGN.md section 8; validation case: shared/cases/paper-double-tee.md.",
+        "Verification cases: docs/validation.md, docs/theory.md §8; validation case: docs/validation.md.",
         "",
         "## Summary",
         "",

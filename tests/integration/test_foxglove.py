@@ -1,7 +1,7 @@
 """Logs for Foxglove: the layout made for each run (``cosim layout``), the 3D scene of real runs (scripted
 and real SUMO), and logs written before either existed. Real runs, real MCAP files, the real command line.
 
-What Foxglove itself shows was checked with ../shared/tools/foxglove/view.sh (a real Foxglove in a real
+What Foxglove itself shows was checked with a script outside this repository (a real Foxglove in a real
 browser; docs/foxglove.md): that needs npm and a browser, so it is not run here. Here: the layout names
 only fields the log really has, and the scene's messages are what Foxglove's schemas describe.
 """
@@ -201,7 +201,7 @@ def test_a_sumo_run_draws_its_traffic_in_the_scene(tmp_path: Path) -> None:
     assert on_deck and {f"vehicle {v}" for v in on_deck} <= drawn
     lanes = sorted(line["points"][0]["y"] for e in scenes[-1]["entities"] if e["id"] == "wheel paths"
                    for line in e["lines"])
-    assert lanes == pytest.approx([-1.875, 1.875], abs=0.01)  # the bundled network's lane centres (README)
+    assert lanes == pytest.approx([-1.875, 1.875], abs=0.01)  # the bundled network's lane centres (docs/sumo.md)
 
 
 def test_every_sensor_quantity_gets_a_plot_and_a_place_in_the_scene(tmp_path: Path) -> None:

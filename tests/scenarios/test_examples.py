@@ -1,4 +1,4 @@
-"""Scripted scenario tests of the README, written with :mod:`cosim.testing` on the scenarios in examples/.
+"""Scripted scenario tests of docs/studies.md, written with :mod:`cosim.testing` on the scenarios in examples/.
 
 - a 40 t truck at 80 km/h on a class B road: the DAF at mid-span stays below
   the Eurocode-style bound, and the run matches its stored log;

@@ -95,7 +95,7 @@ def test_bundled_scenario_loads(name: str) -> None:
     assert sensors["node3_acc"].quantity == "acceleration"
     assert (scenario.solver.dt, scenario.solver.scheme, scenario.solver.basis) == (0.005, "newmark", "direct")
     assert scenario.solver.duration == 20.0
-    # The paper's vehicles (shared/cases/paper-double-tee.md): QC-2 enters 7.5 s (30 m) after QC-1.
+    # The paper's vehicles (docs/validation.md): QC-2 enters 7.5 s (30 m) after QC-1.
     qc1, qc2 = scenario.vehicles
     assert (qc1.id, qc1.model, qc2.id, qc2.model) == ("QC-1", "quarter-car", "QC-2", "quarter-car")
     assert qc1.parameters == {"m_v": 1000.0, "m_w": 100.0, "k_v": 39478.40, "c_v": 5026.55}

@@ -50,7 +50,7 @@ DOUBLE_TEE_AREA_REL = 3e-2
 
 
 def double_tee(t_left: float = 0.40, t_right: float = 0.40) -> list[Plate]:
-    """The paper's double-tee (shared/cases/paper-double-tee.md), midline dimensions."""
+    """The paper's double-tee (docs/validation.md), midline dimensions."""
     return [
         Plate((-6.655, 0.0), (6.655, 0.0), 0.25),
         Plate((3.325, 0.0), (3.325, -2.0), t_left),

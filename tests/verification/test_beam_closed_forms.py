@@ -1,4 +1,4 @@
-"""The 7-DOF beam against closed-form solutions the validation cases do not cover (DESIGN.md section 8).
+"""The 7-DOF beam against closed-form solutions the validation cases do not cover (docs/theory.md §8).
 
 Static deflections, Timoshenko, torsional and lateral-torsional frequencies and
 non-uniform torsion are validation cases (``cosim validate``), judged in
@@ -93,7 +93,7 @@ def test_frequency_convergence_rates():
 # ------------------------------------------------------------ twist sign
 def test_eccentric_load_twists_with_the_documented_sign():
     """A downward load on the left (y > y_S) twists negatively; over S it does not twist."""
-    # Sign convention of DESIGN.md (y > y_S is the left side, z up); a load over S: no twist to 1e-14 rad.
+    # Sign convention of docs/theory.md §1.4 (y > y_S is the left side, z up); a load over S: no twist to 1e-14 rad.
     sec = rectangle(2.0, 1.0)
     L = 10.0
     bridge = build_bridge([L], 10, STEEL, sec, ["rigid-end", "rigid-end"])

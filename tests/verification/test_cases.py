@@ -1,4 +1,4 @@
-"""Every registered validation case meets its stated tolerance (DESIGN.md section 8).
+"""Every registered validation case meets its stated tolerance (docs/validation.md, docs/theory.md §8).
 
 The cases are the ones ``cosim validate`` reports (:data:`cosim.validation.STUDIES`,
 quick settings): each names its reference's source and its tolerance, stated
@@ -37,7 +37,7 @@ def test_case_names_are_unique_across_studies(all_computed) -> None:
 
 
 def test_paper_case_twists_towards_the_loaded_edge_and_factorises_once(computed) -> None:
-    # shared/cases/paper-double-tee.md: the lane at y = +3.325 m twists the deck (Node 2 lowest, then Node 3, Node 1).
+    # docs/validation.md: the lane at y = +3.325 m twists the deck (Node 2 lowest, then Node 3, Node 1).
     nodes = [c for c in computed("paper").cases if not c.informational]
     w1, w2, w3 = (c.values["min_direct"] for c in nodes)
     assert w2 < w3 < w1 < 0

@@ -1,4 +1,4 @@
-"""Vehicle-bridge interaction against closed forms, symmetry and counters (DESIGN.md section 8).
+"""Vehicle-bridge interaction against closed forms, symmetry and counters (docs/theory.md §8).
 
 Fryba's moving force (direct basis), the sprung mass, the paper case, time-step
 convergence, energy conservation and the parked vehicle are validation cases
@@ -49,7 +49,7 @@ def _twist_history(vehicles):
 def test_symmetric_vehicles_do_not_twist_and_one_eccentric_vehicle_twists_negatively():
     car = QuarterCar(m_v=1e4, m_w=1e3, k_v=4e5, c_v=2e4)
     pair = [ScriptedVehicle("L", car, 2.0, 15.0), ScriptedVehicle("R", car, -2.0, 15.0)]
-    # Symmetry of deck and loads (DESIGN.md sign convention): no twist, to round-off (1e-15 m).
+    # Symmetry of deck and loads (docs/theory.md §1.4 sign convention): no twist, to round-off (1e-15 m).
     assert np.max(np.abs(_twist_history(pair))) < NO_TWIST_ABS
     alone = _twist_history([ScriptedVehicle("L", car, 2.0, 15.0)])
     # Left side goes down: negative twist (after it leaves, the deck rings with tiny amplitude).
@@ -75,7 +75,7 @@ def test_stiff_tyre_quarter_car_approaches_the_rigid_contact_model():
         tr = ScriptedTraffic((ScriptedVehicle("V", model, 0.0, 20.0),), 20.0)
         res = simulate(bridge, tr, 1.0, SolverSettings(dt=0.001), [Sensor("mid", 10.0)])
         out.append((res.sensors["mid"], res.vehicle("V")["body_acceleration"]))
-    # A tyre of 1e10 N/m is rigid contact in the limit (DESIGN.md section 4); 1 % / 2 % of the peaks.
+    # A tyre of 1e10 N/m is rigid contact in the limit (docs/theory.md §5.6); 1 % / 2 % of the peaks.
     np.testing.assert_allclose(out[1][0], out[0][0], atol=STIFF_TYRE_DEFLECTION * np.max(np.abs(out[0][0])))
     np.testing.assert_allclose(out[1][1], out[0][1], atol=STIFF_TYRE_ACCELERATION * np.max(np.abs(out[0][1])))
 

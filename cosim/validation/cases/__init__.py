@@ -1,7 +1,7 @@
 """The verification and validation cases of ``cosim validate``: computing only.
 
-Every function here is one study of DESIGN.md section 8 -- the paper's 40 m
-double-tee bridge (``shared/cases/paper-double-tee.md``) or a closed-form or
+Every function here is one study of docs/validation.md -- the paper's 40 m
+double-tee bridge (the paper's validation case there) or a closed-form or
 independent reference of :mod:`cosim.validation.references` -- and returns a
 frozen :class:`~cosim.validation.results.StudyResult`: its cases (error,
 tolerance, the reference's source, the numbers behind the error) and the data

@@ -1,4 +1,4 @@
-"""The paper's 40 m double-tee (Figs. 4-6, ``shared/cases/paper-double-tee.md``): its vehicles, runs and study."""
+"""The paper's 40 m double-tee (Figs. 4-6, docs/validation.md): its vehicles, runs and study."""
 from __future__ import annotations
 
 from collections.abc import Sequence
@@ -32,8 +32,8 @@ __all__ = [
     "paper_runs",
 ]
 
-# The paper's vehicles (Table 2 with the units of DESIGN.md section 9; wheel masses from
-# shared/cases/paper-double-tee.md) and its read-out points at mid-span, deck level.
+# The paper's vehicles (Table 2 with the units of docs/theory.md §3.7; wheel masses from
+# docs/validation.md) and its read-out points at mid-span, deck level.
 PAPER_QC1 = QuarterCar(m_v=1000.0, m_w=100.0, k_v=39478.40, c_v=5026.55)
 PAPER_QC2 = QuarterCar(m_v=2000.0, m_w=200.0, k_v=78956.80, c_v=10053.10)
 PAPER_LANE_Y = 3.325  # m
@@ -102,7 +102,7 @@ def paper_runs(bridge: BridgeModel, dt: float, runs: Sequence[tuple[str, str, bo
 
 def _paper_setup(bridge: BridgeModel, dt: float) -> str:
     return (
-        "Set-up (shared/cases/paper-double-tee.md): bundled scenario paper-double-tee "
+        "Set-up (docs/validation.md): bundled scenario paper-double-tee "
         f"({bridge.n_elements} elements, rigid ends, {bridge.damping_note}; alpha = {bridge.alpha:.6g} 1/s, "
         f"beta = {bridge.beta:.6g} s). QC-1 (m_v 1000 kg, m_w 100 kg, k_v 39478.40 N/m, c_v 5026.55 N s/m) enters "
         f"at t = 0, QC-2 (m_v 2000 kg, m_w 200 kg, k_v 78956.80 N/m, c_v 10053.10 N s/m) at {PAPER_QC2_ENTRY} s, "
@@ -122,7 +122,7 @@ def paper_case(dt: float) -> StudyResult:
     res = paper_runs(bridge, dt, [("qc", "direct", False), ("qc_modal", "modal", False), ("mf", "direct", True)])
     reference = (
         "Direct (full FE) basis as the reference for the modal basis; the set-up of the source paper "
-        "(Figs. 4-6) as fixed by shared/cases/paper-double-tee.md"
+        "(Figs. 4-6) as fixed by docs/validation.md"
     )
     events = ((PAPER_QC2_ENTRY, "QC-2 on"), (bridge.length / PAPER_SPEED, "QC-1 off"),
               (PAPER_QC2_ENTRY + bridge.length / PAPER_SPEED, "QC-2 off"))

@@ -104,7 +104,7 @@ def torsional_frequencies() -> StudyResult:
     ref = torsional_frequencies_hz(np.arange(1, 4), L, STEEL, sec)
     return StudyResult((_frequency_case(
         "Torsional frequencies with warping",
-        "ω² = (GJ k² + E I_w k⁴) / (ρ I_p + ρ I_w k²), k = nπ/L, fork supports (Vlasov; DESIGN.md section 8)",
+        "ω² = (GJ k² + E I_w k⁴) / (ρ I_p + ρ I_w k²), k = nπ/L, fork supports (Vlasov; docs/theory.md §8)",
         fe, ref, [f"torsion {n}" for n in range(1, 4)],
         "Doubly symmetric I-like section (J = 1e-6 m4, I_w = 2e-6 m6), L = 10 m, 40 elements, fork supports.",
     ),))

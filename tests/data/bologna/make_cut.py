@@ -3,7 +3,7 @@
 Run from this folder with the full scenario's folder as the argument (it needs
 SUMO's netconvert and tools, from the eclipse-sumo wheel)::
 
-    python make_cut.py ../../../../shared/data/bologna-acosta
+    python make_cut.py PATH/TO/sumo-scenarios/bologna/acosta
 
 It writes ``west.*`` and ``east.*`` here: a network cut to a box around the
 bridges (netconvert rebuilds the junctions at the box's edge), the routes of
