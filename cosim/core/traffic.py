@@ -1,16 +1,24 @@
 """Traffic seen by the bridge: which vehicles are where, how fast, at a given time (docs/theory.md §6.10).
 
-A traffic source answers :meth:`TrafficSource.frame` for the time of every
-beam step: the vehicles in the simulation with their contact point ``x``
-(m, on the bridge axis), speed ``v`` and acceleration ``a`` along +x (negative
-when driving towards x = 0), lateral offset ``y`` and model. Vehicles that
-appear are put on the deck at static equilibrium; vehicles that disappear are
-gone. :class:`ScriptedTraffic` is the source for runs without SUMO.
+A :class:`TrafficSource` answers :meth:`TrafficSource.block` for the times of
+a block of beam steps: the vehicles in the simulation with their contact point
+``x`` (m, on the bridge axis), speed ``v`` and acceleration ``a`` along +x
+(negative when driving towards x = 0), lateral offset ``y`` and model.
+Vehicles that appear are put on the deck at static equilibrium; vehicles that
+disappear are gone. Every source has one life cycle: :meth:`~TrafficSource.start`
+before the first block, :meth:`~TrafficSource.close` after the last (or use it
+as a context manager); a live traffic simulation holds a process and files in
+between. :class:`ScriptedTraffic` is the source for runs without SUMO;
+:class:`FrameTraffic` follows frames at a fixed step (SUMO's, or a log's),
+and a live source hands every frame to the :class:`FrameSink` it was built
+with (a log).
 """
 from __future__ import annotations
 
+import abc
 import itertools
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -96,10 +104,40 @@ class TrafficBlock:
                             np.concatenate([b.v for b in blocks]), np.concatenate([b.a for b in blocks]), first.y)
 
 
-class TrafficSource(Protocol):
-    """Anything that can say where the vehicles are at the times of a block of steps (s)."""
+class TrafficSource(abc.ABC):
+    """Anything that can say where the vehicles are at the times of a block of steps (s).
 
-    def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock: ...
+    Started before the first block and closed after the last, whatever happens in between (``with source:``):
+    a live traffic simulation holds a process and scratch files until it is closed. Sources that hold
+    nothing inherit the no-op :meth:`start` and :meth:`close`.
+    """
+
+    def start(self) -> TrafficSource:
+        """Get ready for the first block; returns the source."""
+        return self
+
+    def close(self) -> None:  # noqa: B027 - a no-op by default, not abstract: most sources hold nothing
+        """Release what the source holds (idempotent)."""
+
+    def __enter__(self) -> TrafficSource:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @abc.abstractmethod
+    def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
+        """The vehicles on the deck at any of ``times`` (s, increasing), with their kinematics at each."""
+
+
+class FrameSink(Protocol):
+    """Where a live traffic source sends what it produces (a log): every frame with the vehicle models of
+    the types known so far (a mapping that is never changed afterwards), and its documents (the vehicle-type
+    table at the start, the simulator's messages at the end)."""
+
+    def __call__(self, frame: Frame, models: Mapping[str, VehicleModel]) -> None: ...
+
+    def attach(self, name: str, data: bytes | str, media_type: str) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -168,7 +206,7 @@ class ScriptedVehicle:
 
 
 @dataclass(frozen=True)
-class ScriptedTraffic:
+class ScriptedTraffic(TrafficSource):
     """Scripted vehicles on a bridge of length ``length`` m; each is present while on the deck."""
 
     vehicles: tuple[ScriptedVehicle, ...]
@@ -318,7 +356,7 @@ def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
     return out
 
 
-class FrameTraffic:
+class FrameTraffic(TrafficSource):
     """Traffic given as frames at a fixed step (from SUMO, or replayed from a log).
 
     Between two frames a vehicle moves with constant acceleration, as SUMO's
@@ -332,26 +370,35 @@ class FrameTraffic:
     Args:
         step: time between frames, s.
         length: bridge length, m.
-        models: vehicle type -> vehicle model.
+        models: vehicle type -> vehicle model, those known at the start (more come with
+            :meth:`add_models` or :meth:`add_frame`); the source keeps its own table.
     """
 
-    def __init__(self, step: float, length: float, models: dict[str, VehicleModel]) -> None:
+    def __init__(self, step: float, length: float, models: Mapping[str, VehicleModel] | None = None) -> None:
         if not step > 0:
             raise ConfigError(f"traffic `step` must be > 0 s (got {step})")
         self.step = float(step)
         self.length = float(length)
-        self.models = models  # shared: a live source (SUMO) adds types as they appear
+        self._models: dict[str, VehicleModel] = dict(models or {})
         self.frames: list[Frame] = [Frame(0.0, (), *(np.zeros(0),) * 4, ())]
         self._first = 0  # index in self.frames of frames[0]; older frames are dropped
 
-    def add_frame(self, frame: Frame) -> None:
-        """Append the next frame (its time one ``step`` after the last)."""
+    def add_models(self, models: Mapping[str, VehicleModel]) -> None:
+        """Vehicle types (type -> model) that frames may name from now on."""
+        self._models.update(models)
+
+    def add_frame(self, frame: Frame, models: Mapping[str, VehicleModel] | None = None) -> None:
+        """Append the next frame (its time one ``step`` after the last); ``models``: where the models of types
+        it names for the first time are found."""
         expected = self.frames[-1].t + self.step
         if abs(frame.t - expected) > 1e-6 * self.step:
             raise ConfigError(f"traffic frames must be {self.step} s apart (got t = {frame.t}, expected {expected})")
+        own = self._models
         for typ in frame.types:
-            if typ not in self.models:
-                raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
+            if typ not in own:
+                if models is None or typ not in models:
+                    raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
+                own[typ] = models[typ]
         self.frames.append(frame)
 
     @property
@@ -407,7 +454,8 @@ class FrameTraffic:
         on = present & on_deck(X, self.length)
         ids = list(index)
         wanted = on.any(axis=0)
-        if any(getattr(self.models[type_of[c]], "contacts", 1) > 1 for c in np.flatnonzero(wanted).tolist()):
+        models = self._models
+        if any(getattr(models[type_of[c]], "contacts", 1) > 1 for c in np.flatnonzero(wanted).tolist()):
             wanted = self._whole_vehicles(ids, wanted)
         keep = np.flatnonzero(wanted)
         X, V, A = X[:, keep], V[:, keep], A[:, keep]
@@ -419,7 +467,7 @@ class FrameTraffic:
         last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
         Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
         return TrafficBlock(
-            tuple(ids[c] for c in keep.tolist()), tuple(self.models[type_of[c]] for c in keep.tolist()),
+            tuple(ids[c] for c in keep.tolist()), tuple(models[type_of[c]] for c in keep.tolist()),
             np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y,
         )
 

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
-from cosim.core.vehicles import VehicleModel, model_from_dict
+from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, TrafficSource
+from cosim.core.vehicles import model_from_dict
 from cosim.errors import ConfigError, LogError
 
 from .reader import LogContents, iter_messages, read_log
@@ -49,13 +49,12 @@ class _FrameFeed:
     def __init__(self, path: Path, length: float, step: float) -> None:
         self.path = path
         self.step = float(step)
-        self.models: dict[str, VehicleModel] = {}
-        self.traffic = FrameTraffic(step, length, self.models)
+        self.traffic = FrameTraffic(step, length)
         self.frames = 0
 
     def vehicle_type(self, message: dict) -> None:
         try:
-            self.models[message["type"]] = model_from_dict(message["model"])
+            self.traffic.add_models({message["type"]: model_from_dict(message["model"])})
         except (ConfigError, KeyError, TypeError, ValueError) as exc:
             raise LogError(f"{self.path}: a vehicle type on {TOPIC_VEHICLE_TYPES} (t = {message['t']:g} s) is not "
                            f"a valid vehicle model: {exc}") from None
@@ -120,7 +119,7 @@ def read_traffic(path: str | os.PathLike[str], length: float, step: float, until
     return traffic_from_log(contents, length, step, until), len(contents.messages.get(TOPIC_TRAFFIC, []))
 
 
-class LoggedTraffic:
+class LoggedTraffic(TrafficSource):
     """The logged SUMO frames of a log as a traffic source, read from the file as the run needs them.
 
     Memory stays constant however long the log: frames are read chunk by

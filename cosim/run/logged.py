@@ -17,7 +17,7 @@ import os
 import platform
 import secrets
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,8 +30,11 @@ from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
 from cosim.core.checks import one_of
 from cosim.core.limits import MAX_STEPS
-from cosim.core.simulation import SimulationResult, simulate
-from cosim.core.traffic import AXLE_SEPARATOR, ScriptedTraffic
+from cosim.core.roughness import RoadProfile
+from cosim.core.sensors import Sensor
+from cosim.core.simulation import SimulationResult, SolverSettings, simulate
+from cosim.core.traffic import AXLE_SEPARATOR, Frame, FrameSink, ScriptedTraffic, TrafficSource
+from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
 from cosim.log.process import LogProcess, fork_possible
@@ -51,7 +54,7 @@ from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
-from .simulate import SOLVER_FAILURES, build_traffic, likely_cause, plan_sumo
+from .simulate import SOLVER_FAILURES, SumoPlan, build_traffic, likely_cause, plan_sumo
 
 #: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
 FATIGUE_METADATA_NAME = "fatigue"
@@ -234,6 +237,189 @@ def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: 
                           f"is at {modal.f_hz[0]:.4g} Hz); raise cutoff_hz or give modes")
 
 
+class FrameRelay:
+    """The frame sink a live traffic source is built with, before the log it feeds exists.
+
+    SUMO starts before the log (its network, edges and vTypes are inputs too: a wrong one must leave nothing
+    written), and says what it runs (the vehicle-type table) as it starts: documents given before
+    :meth:`connect` wait for it. Frames only come with blocks, after it.
+    """
+
+    def __init__(self) -> None:
+        self._sink: FrameSink | None = None
+        self._held: list[tuple[str, bytes | str, str]] = []
+
+    def connect(self, sink: FrameSink) -> None:
+        """From now on everything goes to ``sink`` (a log's), the documents held first."""
+        self._sink = sink
+        held, self._held = self._held, []
+        for document in held:
+            sink.attach(*document)
+
+    def __call__(self, frame: Frame, models: Mapping[str, VehicleModel]) -> None:
+        if self._sink is None:
+            raise LogError("a traffic frame came before the run's log was open")
+        self._sink(frame, models)
+
+    def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
+        if self._sink is None:
+            self._held.append((name, data, media_type))
+        else:
+            self._sink.attach(name, data, media_type)
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """A logged run as it will be, worked out once from the scenario before anything is written
+    (:func:`plan_run`); the stream that writes the log takes it whole.
+
+    Attributes:
+        scenario: what runs; log_path: the log to write; force: overwrite an existing one.
+        bridge, road, solver: the model, the road profiles and the solver settings.
+        sensors: the scenario's sensors (the scene's hidden ones are added by the stream).
+        duration: simulated time, s; every: steps per logged sample; rate_hz: logging rate, Hz.
+        scene: the log's 3D scene, or None.
+        sumo: the SUMO run to start (its network, edges and vTypes read), or None (scripted or given traffic).
+        writer_child: the log is encoded and written by a child process (else a thread).
+        metadata: the "cosim" metadata record; replay: the "replay" record of a replay, or None.
+        documents: the attachments (input files, resolved parameters, section, modes, layout), name -> bytes.
+    """
+
+    scenario: Scenario
+    log_path: Path
+    force: bool
+    bridge: BridgeModel
+    road: RoadProfile
+    solver: SolverSettings
+    sensors: tuple[Sensor, ...]
+    duration: float
+    every: int
+    rate_hz: float
+    scene: ScenePlan | None
+    sumo: SumoPlan | None
+    writer_child: bool
+    metadata: Mapping[str, str]
+    replay: Mapping[str, str] | None
+    documents: Mapping[str, bytes]
+
+    @property
+    def names(self) -> list[str]:
+        """The logged sensors' names."""
+        return [s.name for s in self.sensors]
+
+
+def _metadata(scenario: Scenario, plan_scene_: ScenePlan | None, solver: SolverSettings, sensors: list[Sensor],
+              duration: float, every: int, rate_hz: float, traffic: TrafficSource | None, live_sumo: bool,
+              inputs: list, started: datetime.datetime, replay: bool) -> dict[str, str]:
+    """The "cosim" metadata record of a run's log."""
+    contacts = _contact_ids(traffic)
+    return {
+        "version": __version__,
+        "kind": "replay" if replay else "run",
+        "scenario": scenario.title,
+        "source": scenario.source,
+        "started": started.isoformat(timespec="seconds"),
+        "dt": repr(solver.dt),
+        "scheme": solver.scheme,
+        "basis": solver.basis,
+        "duration": repr(duration),
+        "every": str(every),
+        "rate_hz": repr(rate_hz),
+        "sensors": json.dumps([s.name for s in sensors]),
+        "quantities": json.dumps([s.quantity for s in sensors]),
+        "vehicles": json.dumps([v.id for v in scenario.vehicles]),
+        "traffic": "sumo" if (live_sumo or scenario.traffic is not None) else (
+            "replayed frames" if traffic is not None and not scenario.vehicles else "scripted"),
+        "inputs": json.dumps({item.key: item.attachment for item in inputs if item.key}),
+        "python": platform.python_version(),
+        **({"contacts": json.dumps(contacts)} if contacts is not None else {}),
+        **(plan_scene_.metadata() if plan_scene_ is not None else {}),
+    }
+
+
+def _documents(scenario: Scenario, bridge: BridgeModel, modal: Any, inputs: list, attachments: dict[str, bytes],
+               layout: Any, duration: float, every: int, rate_hz: float) -> dict[str, bytes]:
+    """The log's attachments besides the scenario text: its input files (read now: an unreadable one is an
+    error before the log exists), the resolved parameters, the section, the modes and the Foxglove layout."""
+    files = {}
+    for item in inputs:
+        try:
+            files[item.attachment] = item.path.read_bytes()
+        except OSError as exc:
+            raise ConfigError(f"{scenario.source}: {item.key or item.attachment}: cannot read {item.path} "
+                              f"({exc.strerror})") from None
+    resolved = {
+        "scenario": scenario.model_dump(mode="json", by_alias=True, warnings=False),
+        "derived": {"duration": duration, "output_every": every, "rate_hz": rate_hz,
+                    "leave_time": jsonable(scenario.leave_time)},
+    }
+    return {
+        **files, **attachments,
+        "resolved.json": json.dumps(jsonable(resolved), indent=1).encode(),
+        "section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
+        "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
+                                 indent=1).encode(),
+        LAYOUT_ATTACHMENT: layout_bytes(layout),
+    }
+
+
+def plan_run(
+    scenario: Scenario,
+    log_path: Path,
+    *,
+    force: bool = False,
+    bridge: BridgeModel | None = None,
+    replay: dict[str, str] | None = None,
+    attachments: dict[str, bytes] | None = None,
+    started: datetime.datetime | None = None,
+    traffic: TrafficSource | None = None,
+    duration: float | None = None,
+    scene_by_default: bool = True,
+    writer: str = "auto",
+) -> RunPlan:
+    """Work out a logged run (:func:`run_logged`'s arguments, which it documents) without writing anything.
+
+    Raises:
+        ConfigError, ModelError, LogError, SumoError: bad input (the bridge, road, vehicles, modes, limits, SUMO's
+            network, edges and vehicle types, an existing log without ``force``).
+    """
+    if not scenario.vehicles and scenario.traffic is None and traffic is None:
+        raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
+                          "nothing to simulate in time")
+    one_of(writer, LOG_WRITERS, "writer", "run_logged: ")
+    writer_child = writer == "process" or (writer == "auto" and fork_possible())
+    if writer_child and not fork_possible():
+        raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "
+                          "may start children; use \"thread\" or \"auto\"")
+    started = started or datetime.datetime.now().astimezone()
+    if bridge is None:
+        bridge = scenario.build_bridge()
+    live_sumo = traffic is None and scenario.traffic is not None
+    sumo_plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
+    if traffic is None and not live_sumo:
+        traffic = scenario.build_vehicles()
+    road = scenario.build_road()
+    solver = scenario.solver_settings()
+    sensors = scenario.sensors_core()
+    given = duration is not None
+    duration = duration if duration is not None else scenario.duration
+    every = scenario.output_every
+    rate_hz = scenario.output_rate_hz
+    names = [s.name for s in sensors]
+    modal = bridge.modes(count=LOGGED_MODES)
+    _check_size(scenario, bridge, solver, duration, given, modal)
+    scene = _scene_plan(scenario, bridge, sensors, solver, duration, traffic, scene_by_default)
+    inputs = input_files(scenario)
+    meta = _metadata(scenario, scene, solver, sensors, duration, every, rate_hz, traffic, live_sumo, inputs,
+                     started, bool(replay))
+    layout = make_layout(inputs_from_metadata(meta, names, [s.quantity for s in sensors], str(log_path)))
+    documents = _documents(scenario, bridge, modal, inputs, attachments or {}, layout, duration, every, rate_hz)
+    check_new_file(log_path, "log", force)
+    return RunPlan(scenario=scenario, log_path=log_path, force=force, bridge=bridge, road=road, solver=solver,
+                   sensors=tuple(sensors), duration=duration, every=every, rate_hz=rate_hz, scene=scene,
+                   sumo=sumo_plan, writer_child=writer_child, metadata=meta, replay=replay, documents=documents)
+
+
 def run_logged(
     scenario: Scenario,
     log_path: Path,
@@ -244,7 +430,7 @@ def run_logged(
     replay: dict[str, str] | None = None,
     attachments: dict[str, bytes] | None = None,
     started: datetime.datetime | None = None,
-    traffic: Any = None,
+    traffic: TrafficSource | None = None,
     duration: float | None = None,
     scene_by_default: bool = True,
     writer: str = "auto",
@@ -253,7 +439,7 @@ def run_logged(
 
     Everything that can fail on bad input (bridge, road, vehicles, modes,
     limits, SUMO: its network, edges and vehicle types) is checked before the
-    log file is created. The log is written under a temporary name in the same
+    log file is created (:func:`plan_run`). The log is written under a temporary name in the same
     folder and takes its name when the time stepping starts: a run that fails
     or is stopped before that leaves nothing (and an existing ``log_path``
     untouched, even with ``force``). From then on the log is kept, and finished
@@ -287,88 +473,21 @@ def run_logged(
         RunFailed: the run failed after it started (e.g. diverged); the log ends with status "error".
         ConfigError, ModelError, LogError, SumoError: bad input, before any file is written.
     """
-    if not scenario.vehicles and scenario.traffic is None and traffic is None:
-        raise ConfigError(f"{scenario.source}: the scenario has no [[vehicles]] and no [traffic]: "
-                          "nothing to simulate in time")
-    one_of(writer, LOG_WRITERS, "writer", "run_logged: ")
-    writer_child = writer == "process" or (writer == "auto" and fork_possible())
-    if writer_child and not fork_possible():
-        raise ConfigError("run_logged: writer = \"process\" needs Linux and the main thread of a process that "
-                          "may start children; use \"thread\" or \"auto\"")
-    started = started or datetime.datetime.now().astimezone()
-    if bridge is None:
-        bridge = scenario.build_bridge()
-    live_sumo = traffic is None and scenario.traffic is not None
-    sumo_plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
-    if traffic is None and not live_sumo:
-        traffic = scenario.build_vehicles()
-    road = scenario.build_road()
-    solver = scenario.solver_settings()
-    sensors = scenario.sensors_core()
-    given = duration is not None
-    duration = duration if duration is not None else scenario.duration
-    every = scenario.output_every
-    rate_hz = scenario.output_rate_hz
-    names = [s.name for s in sensors]
-    modal = bridge.modes(count=LOGGED_MODES)
-    _check_size(scenario, bridge, solver, duration, given, modal)
-    plan = _scene_plan(scenario, bridge, sensors, solver, duration, traffic, scene_by_default)
-    contacts = _contact_ids(traffic)
-    inputs = input_files(scenario)
-    files = {}
-    for item in inputs:
-        try:
-            files[item.attachment] = item.path.read_bytes()
-        except OSError as exc:
-            raise ConfigError(f"{scenario.source}: {item.key or item.attachment}: cannot read {item.path} "
-                              f"({exc.strerror})") from None
-    check_new_file(log_path, "log", force)
-    meta = {
-        "version": __version__,
-        "kind": "replay" if replay else "run",
-        "scenario": scenario.title,
-        "source": scenario.source,
-        "started": started.isoformat(timespec="seconds"),
-        "dt": repr(solver.dt),
-        "scheme": solver.scheme,
-        "basis": solver.basis,
-        "duration": repr(duration),
-        "every": str(every),
-        "rate_hz": repr(rate_hz),
-        "sensors": json.dumps(names),
-        "quantities": json.dumps([s.quantity for s in sensors]),
-        "vehicles": json.dumps([v.id for v in scenario.vehicles]),
-        "traffic": "sumo" if (live_sumo or scenario.traffic is not None) else (
-            "replayed frames" if traffic is not None and not scenario.vehicles else "scripted"),
-        "inputs": json.dumps({item.key: item.attachment for item in inputs if item.key}),
-        "python": platform.python_version(),
-        **({"contacts": json.dumps(contacts)} if contacts is not None else {}),
-        **(plan.metadata() if plan is not None else {}),
-    }
-    layout = make_layout(inputs_from_metadata(meta, names, [s.quantity for s in sensors], str(log_path)))
-    resolved = {
-        "scenario": scenario.model_dump(mode="json", by_alias=True, warnings=False),
-        "derived": {"duration": duration, "output_every": every, "rate_hz": rate_hz,
-                    "leave_time": jsonable(scenario.leave_time)},
-    }
-    documents = {
-        **files, **(attachments or {}),
-        "resolved.json": json.dumps(jsonable(resolved), indent=1).encode(),
-        "section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
-        "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
-                                 indent=1).encode(),
-        LAYOUT_ATTACHMENT: layout_bytes(layout),
-    }
+    plan = plan_run(scenario, log_path, force=force, bridge=bridge, replay=replay, attachments=attachments,
+                    started=started, traffic=traffic, duration=duration, scene_by_default=scene_by_default,
+                    writer=writer)
+    relay = FrameRelay()
     with stop_signals() as guard, contextlib.ExitStack() as sumo:
         try:
-            if live_sumo:  # SUMO starts before the log: its network, edges and vTypes are inputs too
-                traffic = sumo.enter_context(build_traffic(scenario, plan=sumo_plan,
-                                                           process=_sumo_process(plan, writer_child)))
+            if plan.sumo is not None:  # SUMO starts before the log: its network, edges and vTypes are inputs too
+                traffic = sumo.enter_context(build_traffic(
+                    scenario, frame_sink=relay, plan=plan.sumo, process=_sumo_process(plan.scene, plan.writer_child)))
+            elif traffic is None:
+                traffic = scenario.build_vehicles()
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None
-        return _stream(scenario, log_path, force, guard, bridge, traffic, live_sumo, road, solver, sensors,
-                       duration, every, rate_hz, meta, replay, documents, progress, plan, writer_child)
+        return _stream(plan, guard, traffic, relay if plan.sumo is not None else None, progress)
 
 
 def _sumo_process(plan: ScenePlan | None, writer_child: bool) -> bool | None:
@@ -383,12 +502,14 @@ def _sumo_process(plan: ScenePlan | None, writer_child: bool) -> bool | None:
     return None if plan is None and writer_child else False
 
 
-def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, bridge: BridgeModel, traffic: Any,
-            live_sumo: bool, road: Any, solver: Any, sensors: list, duration: float, every: int, rate_hz: float,
-            meta: dict[str, str], replay: dict[str, str] | None, documents: dict[str, bytes],
-            progress: Callable[[float], None] | None, plan: ScenePlan | None, writer_child: bool) -> RunOutcome:
-    """The log itself: written under a temporary name until the stepping starts, then as ``log_path``."""
-    names = [s.name for s in sensors]
+def _stream(run: RunPlan, guard: StopGuard, traffic: TrafficSource, relay: FrameRelay | None,
+            progress: Callable[[float], None] | None) -> RunOutcome:
+    """The log itself: written under a temporary name until the stepping starts, then as ``log_path``.
+    ``relay``: the frame sink live SUMO was built with (connected to the log here), or None."""
+    scenario, log_path, force, plan = run.scenario, run.log_path, run.force, run.scene
+    solver, road, duration, rate_hz = run.solver, run.road, run.duration, run.rate_hz
+    names = run.names
+    live_sumo = relay is not None
     partial = log_path.with_name(f".{log_path.name}.{secrets.token_hex(4)}.part")
     extremes = _DeckTimes()
     samples = _Samples()
@@ -423,18 +544,18 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
 
     try:
         try:
-            rec = (LogProcess(partial, names, scene=plan is not None) if writer_child else
+            rec = (LogProcess(partial, names, scene=plan is not None) if run.writer_child else
                    LogRecorder(partial, names, force=False, scene=plan is not None))
         except LogError as exc:  # name the log the user asked for, not its temporary name
             raise LogError(str(exc).replace(str(partial), str(log_path))) from None
         rec.attach(SCENARIO_ATTACHMENT, scenario.text, "application/toml")
-        for name, data in documents.items():
+        for name, data in run.documents.items():
             media = {".csv": "text/csv", ".toml": "application/toml", ".json": "application/json"}.get(
                 Path(name).suffix.lower(), "application/octet-stream")
             rec.attach(name, data, media)
-        rec.metadata(METADATA_NAME, meta)
-        if replay:
-            rec.metadata(REPLAY_METADATA_NAME, replay)
+        rec.metadata(METADATA_NAME, dict(run.metadata))
+        if run.replay:
+            rec.metadata(REPLAY_METADATA_NAME, dict(run.replay))
         rec.status(0.0, "started", f"{scenario.title}: {duration:g} s simulated, dt = {solver.dt:g} s, "
                                    f"logging at {rate_hz:g} Hz", progress=0.0)
         rec.write(TOPIC_SENSORS, 0.0, {"t": 0.0, **{n: 0.0 for n in names}})  # at rest
@@ -446,13 +567,12 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
             blocks = BlockLogger.for_run(rec, names, duration, status_every=STATUS_EVERY, plan=plan,
                                          first_column=len(names), piece_steps=piece, threaded=True)
         with blocks as logger:
-            if live_sumo:
-                traffic.frame_sink = logger.traffic_sink()
-                traffic.log_documents(rec.attach)
-            result = simulate(bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration, solver=solver,
-                              sensors=[*sensors, *(scene_sensors(plan) if plan is not None else [])], road=road,
-                              output_every=every, progress=progress, observers=[extremes, samples, fatigue, logger],
-                              collect=False)
+            if relay is not None:
+                relay.connect(logger.traffic_sink())
+            result = simulate(run.bridge, logger.paced(_StartsOnFirstBlock(traffic, on_start)), duration,
+                              solver=solver, sensors=[*run.sensors, *(scene_sensors(plan) if plan is not None else [])],
+                              road=road, output_every=run.every, progress=progress,
+                              observers=[extremes, samples, fatigue, logger], collect=False)
             guard.closing = True  # a signal from here on must not cut the log's ending short
     except KeyboardInterrupt as exc:
         guard.closing = True
@@ -500,7 +620,7 @@ def _stream(scenario: Scenario, log_path: Path, force: bool, guard: StopGuard, b
     if plan is not None:
         result = _named_only(result, names)
     return RunOutcome(
-        scenario=scenario, log_path=log_path, result=result, duration=duration, every=every, rate_hz=rate_hz,
+        scenario=scenario, log_path=log_path, result=result, duration=duration, every=run.every, rate_hz=rate_hz,
         on_deck={k: (v[0], v[1]) for k, v in extremes.spans.items()}, samples=samples.count + 1,
         wall_time=wall, log_bytes=log_path.stat().st_size, fatigue=damage,
     )

@@ -18,19 +18,22 @@ before anything is written.
 """
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from cosim.core.bridge import BridgeModel
 from cosim.core.simulation import SimulationResult, simulate
+from cosim.core.traffic import FrameSink, TrafficSource
 from cosim.errors import ConfigError, ModelError, SumoError
 
 from .scenario import Scenario
+
+if TYPE_CHECKING:
+    from cosim.sumo.adapter import SumoSettings
 
 #: Exceptions of the compiled solver (numba, numpy) when non-finite values reach it: a diverged solution.
 SOLVER_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
@@ -75,6 +78,7 @@ class SumoPlan:
         demand: what the demand files hold (:class:`cosim.sumo.files.Demand`).
         types: every vType's vehicle model (:class:`cosim.sumo.vtypes.VehicleType`), as the files say it;
             a vType without a ``length`` has its library vehicle's here and SUMO's own in the run.
+        settings: the SUMO run itself (:class:`cosim.sumo.adapter.SumoSettings`: config, axis, times, seed).
     """
 
     config: Path
@@ -85,6 +89,7 @@ class SumoPlan:
     deck_y: tuple[float, float]
     demand: Any
     types: tuple[Any, ...]
+    settings: SumoSettings
 
 
 def plan_sumo(scenario: Scenario) -> SumoPlan:
@@ -98,6 +103,7 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         ConfigError: naming the scenario and the key: an edge the network lacks, lanes off the deck, a
             length that does not match, no lane on the axis, a vType with an unknown or impossible param.
     """
+    from cosim.sumo.adapter import SumoSettings
     from cosim.sumo.files import read_demand
     from cosim.sumo.network import BridgeAxis, lanes_across, locate_bridge, net_path
     from cosim.sumo.vtypes import vehicle_type
@@ -148,18 +154,21 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         except SumoError as exc:
             where = f"{entry.file}: " if entry is not None else ""
             raise ConfigError(f"{scenario.source}: traffic.sumo_config: {where}{exc}") from None
+    with scenario.named("traffic"):
+        settings = SumoSettings(config, axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
+                                seed=t.seed, deck_y=deck_y, demand=demand)
     return SumoPlan(config=config, net=net, axis=axis, axis_from=axis_from, location=location, deck_y=deck_y,
-                    demand=demand, types=tuple(types))
+                    demand=demand, types=tuple(types), settings=settings)
 
 
-def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = None,
-                  plan: SumoPlan | None = None, process: bool | None = None) -> Any:
-    """The scenario's traffic source: for ``[traffic]``, SUMO (not started) in a child process
+def build_traffic(scenario: Scenario, frame_sink: FrameSink | None = None, plan: SumoPlan | None = None,
+                  process: bool | None = None) -> TrafficSource:
+    """The scenario's traffic source, not started: for ``[traffic]``, SUMO in a child process
     (:class:`cosim.run.sumo_process.SumoProcess`) or in this one (:class:`cosim.sumo.adapter.SumoTraffic`);
     else its scripted vehicles (:meth:`Scenario.build_vehicles`).
 
     Args:
-        frame_sink: with SUMO, called with every frame (e.g. to log it).
+        frame_sink: with SUMO, where every frame and the run's documents go (e.g. a log).
         plan: with SUMO, the run's :func:`plan_sumo` if already made.
         process: SUMO in a child process (the same frames; the run's process keeps its GIL); None: where a
             child can be forked (:func:`cosim.log.process.fork_possible`).
@@ -168,11 +177,8 @@ def build_traffic(scenario: Scenario, frame_sink: Callable[..., None] | None = N
         return scenario.build_vehicles()
     from cosim.sumo.adapter import SumoTraffic  # only SUMO runs load libsumo
 
-    t = scenario.traffic
     plan = plan or plan_sumo(scenario)
-    with scenario.named("traffic"):
-        traffic = SumoTraffic(plan.config, plan.axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
-                              seed=t.seed, deck_y=plan.deck_y, frame_sink=frame_sink, demand=plan.demand)
+    traffic = SumoTraffic(settings=plan.settings, frame_sink=frame_sink)
     from cosim.log.process import fork_possible
 
     if process or (process is None and fork_possible()):
@@ -210,9 +216,7 @@ def simulate_scenario(
     solver = scenario.solver_settings()
     sensors = scenario.sensors_core()
     try:
-        with contextlib.ExitStack() as stack:
-            if hasattr(traffic, "start"):  # SUMO: one simulation, closed whatever happens
-                stack.enter_context(traffic)
+        with traffic:  # SUMO: one simulation, closed whatever happens
             return simulate(
                 bridge, traffic, duration, solver=solver, sensors=sensors, road=road,
                 output_every=scenario.output_every, progress=progress,

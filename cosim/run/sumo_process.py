@@ -29,20 +29,14 @@ from __future__ import annotations
 
 import collections
 import contextlib
-import json
 import multiprocessing
-from collections.abc import Callable
 from multiprocessing.connection import Connection
 from typing import Any
 
-import numpy as np
-
 from cosim import errors
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, pack_frames, unpack_frames
-from cosim.core.vehicles import VehicleModel
+from cosim.core.traffic import Frame, pack_frames, unpack_frames
 from cosim.log.process import fork_child, signals_held
-from cosim.sumo.adapter import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT, SumoTraffic, follow_frames
-from cosim.sumo.vtypes import VehicleType
+from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT, LiveSumo, SumoSettings, SumoTraffic
 
 __all__ = ["AHEAD_SECONDS", "SumoProcess"]
 
@@ -60,18 +54,33 @@ def _error(kind: str, message: str) -> errors.CosimError:
     return cls(message)
 
 
-def _serve(traffic: SumoTraffic, out: Connection, control: Connection) -> None:
-    traffic.frame_sink = None  # the run's sink gets the frames in the run
+class _Documents:
+    """The child's frame sink: it keeps the documents SUMO's start and close give (the run's sink gets the
+    frames and the documents in the run); the child steps SUMO itself, so no frame comes here."""
+
+    def __init__(self) -> None:
+        self.documents: dict[str, bytes | str] = {}
+
+    def __call__(self, frame: Frame, models: object) -> None:
+        raise AssertionError("the child steps SUMO with advance(), not through its sink")
+
+    def attach(self, name: str, data: bytes | str, media_type: str) -> None:
+        self.documents[name] = data
+
+
+def _serve(settings: SumoSettings, out: Connection, control: Connection) -> None:
+    documents = _Documents()
+    traffic = SumoTraffic(settings=settings, frame_sink=documents)
     try:
         traffic.start()
+        table = documents.documents[VEHICLE_TYPES_ATTACHMENT]
     except BaseException as exc:  # noqa: BLE001 - reported to the run, which raises it
         out.send(("error", type(exc).__name__, str(exc)))
         return
     try:
         out.send(("started", {
             "edges": traffic.edges, "lanes": traffic.lanes, "deck_lanes": traffic.deck_lanes, "reach": traffic.reach,
-            "types": dict(traffic.types), "models": dict(traffic.models),
-            "table": json.dumps([t.summary() for t in traffic.table()], indent=1)}))
+            "types": dict(traffic.types), "models": dict(traffic.models), "table": table}))
         per_message = max(1, int(round(AHEAD_SECONDS / traffic.step)))
         sent_types: set[str] = set(traffic.types)
         sent_models: set[str] = set(traffic.models)
@@ -104,29 +113,16 @@ def _serve(traffic: SumoTraffic, out: Connection, control: Connection) -> None:
             out.send(("closed", traffic.messages, traffic.teleports))
 
 
-class SumoProcess:
-    """A :class:`cosim.sumo.adapter.SumoTraffic` stepped in a forked child; the same traffic-source interface.
+class SumoProcess(LiveSumo):
+    """SUMO stepped in a forked child (a :class:`cosim.sumo.adapter.SumoTraffic` there), as a traffic source
+    with the same frames, frame sink and documents as SUMO in this process (:class:`~cosim.sumo.adapter.LiveSumo`).
 
     Args:
-        traffic: the SUMO traffic, not started (it is started in the child).
+        traffic: the SUMO traffic, not started: its settings run in the child, its frame sink stays here.
     """
 
     def __init__(self, traffic: SumoTraffic) -> None:
-        self.traffic = traffic
-        self.config, self.axis, self.step = traffic.config, traffic.axis, traffic.step
-        self.begin, self.end, self.seed, self.deck_y = traffic.begin, traffic.end, traffic.seed, traffic.deck_y
-        self.frame_sink: Callable[[Frame, dict[str, VehicleModel]], None] | None = traffic.frame_sink
-        self.edges: tuple[str, ...] = ()
-        self.lanes: tuple[str, ...] = ()
-        self.deck_lanes: tuple[str, ...] = ()
-        self.reach = traffic.reach
-        self.models: dict[str, VehicleModel] = {}
-        self.types: dict[str, VehicleType] = {}
-        self.frames: FrameTraffic | None = None
-        self.sumo_steps = 0
-        self.teleports = 0  # as counted by the child, which runs up to AHEAD_SECONDS (and the pipe) ahead
-        self.messages = ""
-        self._table = "[]"
+        super().__init__(traffic.settings, traffic.frame_sink)
         self._waiting: collections.deque[Frame] = collections.deque()
         self._failed: errors.CosimError | None = None
         self._process: Any = None
@@ -134,11 +130,11 @@ class SumoProcess:
         self._control: Connection | None = None
 
     # ------------------------------------------------------------- lifecycle
-    def start(self) -> SumoProcess:
+    def _start_sumo(self) -> str:
         context = multiprocessing.get_context("fork")
         out_recv, out_send = context.Pipe(duplex=False)
         control_recv, control_send = context.Pipe(duplex=False)
-        self._process = fork_child("cosim-sumo", _serve, (self.traffic, out_send, control_recv),
+        self._process = fork_child("cosim-sumo", _serve, (self.settings, out_send, control_recv),
                                    child_ends=(out_send, control_recv), parent_ends=(out_recv, control_send))
         self._out, self._control = out_recv, control_send
         try:
@@ -153,24 +149,13 @@ class SumoProcess:
         self.edges, self.lanes, self.deck_lanes, self.reach = (state["edges"], state["lanes"], state["deck_lanes"],
                                                                state["reach"])
         self.types.update(state["types"])
-        self.models.update(state["models"])
-        self._table = state["table"]
-        attach = getattr(self.frame_sink, "attach", None)
-        if attach is not None:
-            self.log_documents(attach)
-        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
-        return self
+        self._known(state["models"])
+        return str(state["table"])
 
-    def __enter__(self) -> SumoProcess:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def close(self) -> None:
-        """Close SUMO in the child (its messages come back and go to the frame sink, as the adapter's do)."""
+    def _close_sumo(self) -> bool:
+        """Close SUMO in the child; its messages come back."""
         if self._process is None:
-            return
+            return False
         process, self._process = self._process, None
         closed = False
         try:
@@ -195,10 +180,7 @@ class SumoProcess:
             if process.is_alive():
                 process.kill()
                 process.join()
-        attach = getattr(self.frame_sink, "attach", None)
-        if attach is not None and self.messages:
-            with contextlib.suppress(Exception):  # the log may already be closed (its own failure)
-                attach(MESSAGES_FILE, self.messages, "text/plain")
+        return True
 
     # --------------------------------------------------------------- frames
     def _receive(self) -> tuple:
@@ -224,15 +206,7 @@ class SumoProcess:
             if message[0] == "frames":
                 _, packed, new_types, models, self.teleports = message
                 self.types.update(new_types)
-                self.models.update(models)  # the same dict FrameTraffic holds: a new type is known at once
+                self._known(models)
                 self._waiting.extend(unpack_frames(packed))
         self.sumo_steps += 1
         return self._waiting.popleft()
-
-    def block(self, times: np.ndarray) -> TrafficBlock:
-        """As :meth:`cosim.sumo.adapter.SumoTraffic.block`, with the frames the child sends."""
-        return follow_frames(self, times, self._next_frame)
-
-    def log_documents(self, attach: Callable[[str, bytes | str, str], None]) -> None:
-        """Attach the vehicle-type table to a log opened after the start."""
-        attach(VEHICLE_TYPES_ATTACHMENT, self._table, "application/json")

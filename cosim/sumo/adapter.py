@@ -36,23 +36,25 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
 
 from cosim.core.axle_paths import AxleTrails, axles_on_path, path_behind, record_fronts
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock
+from cosim.core.traffic import Frame, FrameSink, FrameTraffic, TrafficBlock, TrafficSource
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
 from cosim.sumo.vtypes import VehicleType, vehicle_type
 
-__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "SumoTraffic",
-           "bundled_networks", "follow_frames", "sumo_binary"]
+__all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "LiveSumo", "SumoSettings",
+           "SumoTraffic", "bundled_networks", "sumo_binary"]
 
 #: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
 WATCH_MARGIN = 12.0
@@ -113,30 +115,180 @@ def _captured_output(into: Path) -> Iterator[None]:
             os.close(fd)
 
 
-class SumoTraffic:
-    """Vehicles from a SUMO simulation (through libsumo), as a traffic source for the beam.
+@dataclass(frozen=True)
+class SumoSettings:
+    """What a SUMO run is: the config, where the bridge is in its network, the times, the seed.
 
-    Args:
+    Attributes:
         config: the ``.sumocfg`` to run (it is copied with its files into a scratch folder and run there).
         axis: where the bridge is in the network.
         step: SUMO's step length, s (the beam's dt must divide it).
         begin, end: SUMO times to run, s (the co-simulation's t = 0 is ``begin``).
         edges: the deck's edges; their lanes (and the opposite direction's between the same junctions)
-            are the deck's. Default: every lane running through the deck's box.
+            are the deck's. None: every lane running through the deck's box.
         seed: SUMO's random seed (recorded in the log), or None for the config's.
-        half_width: lateral half-width of the deck, m, when ``deck_y`` is not given.
-        extra_args: further SUMO command-line options.
-        frame_sink: called with every frame and the model table (e.g. a log's TrafficLogger); if it has
-            an ``attach(name, data, media_type)`` method, the vehicle types (at the start) and SUMO's
-            messages (at the end) are given to it too.
         deck_y: the deck's lateral extent (y_min, y_max), m: an axle outside it is not on the bridge.
+        extra_args: further SUMO command-line options.
         demand: the config's demand files as read (:func:`cosim.sumo.files.read_demand`), if already read.
+
+    Raises:
+        SumoError, ConfigError: a config that is not there, a step or times that are not physical.
+    """
+
+    config: Path
+    axis: BridgeAxis
+    step: float = 0.05
+    begin: float = 0.0
+    end: float = 600.0
+    edges: tuple[str, ...] | None = None
+    seed: int | None = None
+    deck_y: tuple[float, float] = (-50.0, 50.0)
+    extra_args: tuple[str, ...] = ()
+    demand: Demand | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "config", Path(self.config))
+        if not self.config.is_file():
+            raise SumoError(f"{self.config}: SUMO config not found")
+        if not self.step > 0:
+            raise ConfigError(f"traffic `step` must be > 0 s (got {self.step})")
+        if not self.end > self.begin:
+            raise ConfigError(f"traffic `end` ({self.end} s) must be after `begin` ({self.begin} s)")
+        object.__setattr__(self, "step", float(self.step))
+        object.__setattr__(self, "deck_y", (float(self.deck_y[0]), float(self.deck_y[1])))
+        object.__setattr__(self, "edges", tuple(self.edges) if self.edges else None)
+        object.__setattr__(self, "extra_args", tuple(self.extra_args))
+
+
+class LiveSumo(TrafficSource):
+    """SUMO's frames as a traffic source: what SUMO stepped in this process (:class:`SumoTraffic`) and in a
+    child process (:class:`cosim.run.sumo_process.SumoProcess`) share.
+
+    Its frames go, as they come, into the :class:`~cosim.core.traffic.FrameSink` it is built with (a log),
+    with the models of the vehicle types known so far: a mapping that is replaced, never changed, when a type
+    appears. The sink also gets the vehicle-type table when SUMO has started and SUMO's messages when it has
+    closed. The frames feed a :class:`~cosim.core.traffic.FrameTraffic`, which the beam sub-steps through.
+    """
+
+    def __init__(self, settings: SumoSettings, frame_sink: FrameSink | None = None) -> None:
+        self.settings = settings
+        self.frame_sink = frame_sink
+        self.edges: tuple[str, ...] = ()
+        self.lanes: tuple[str, ...] = ()
+        self.deck_lanes: tuple[str, ...] = ()
+        self.reach = WATCH_MARGIN
+        self.models: Mapping[str, VehicleModel] = MappingProxyType({})
+        self.types: dict[str, VehicleType] = {}
+        self.frames: FrameTraffic | None = None
+        self.sumo_steps = 0
+        self.teleports = 0
+        self.messages = ""  # SUMO's own messages, once closed
+
+    @property
+    def config(self) -> Path:
+        return self.settings.config
+
+    @property
+    def axis(self) -> BridgeAxis:
+        return self.settings.axis
+
+    @property
+    def step(self) -> float:
+        return self.settings.step
+
+    @property
+    def begin(self) -> float:
+        return self.settings.begin
+
+    @property
+    def end(self) -> float:
+        return self.settings.end
+
+    @property
+    def seed(self) -> int | None:
+        return self.settings.seed
+
+    @property
+    def deck_y(self) -> tuple[float, float]:
+        return self.settings.deck_y
+
+    def _known(self, models: Mapping[str, VehicleModel]) -> None:
+        """More vehicle types: a new mapping (the one frames were handed with stays as it was)."""
+        if any(k not in self.models for k in models):
+            self.models = MappingProxyType({**self.models, **models})
+
+    def _attach(self, name: str, data: bytes | str, media_type: str) -> None:
+        if self.frame_sink is not None:
+            self.frame_sink.attach(name, data, media_type)
+
+    # ------------------------------------------------------------- lifecycle
+    def start(self) -> LiveSumo:
+        """Start SUMO; the sink gets the vehicle-type table (model, mass, axles and their sources)."""
+        table = self._start_sumo()
+        try:
+            self._attach(VEHICLE_TYPES_ATTACHMENT, table, "application/json")
+        except BaseException:
+            self.close()
+            raise
+        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
+        return self
+
+    def close(self) -> None:
+        """Close SUMO (idempotent); the sink gets SUMO's messages (the log may already be closed: then not)."""
+        if self._close_sumo() and self.messages:
+            with contextlib.suppress(Exception):  # the log may already be closed (its own failure)
+                self._attach(MESSAGES_FILE, self.messages, "text/plain")
+
+    def __enter__(self) -> LiveSumo:
+        return self.start()
+
+    def block(self, times: np.ndarray) -> TrafficBlock:
+        """Take SUMO's frames as far as ``times`` (s from ``begin``) need, each handed to the frame sink as it
+        comes, and interpolate the vehicles there."""
+        frames = self.frames
+        if frames is None:
+            raise SumoError(f"{type(self).__name__}.start() was not called")
+        while frames.last_time < times[-1] - 1e-9:
+            if self.begin + frames.last_time + self.step > self.end + 1e-9:
+                raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
+            frame = self._next_frame()
+            models = self.models
+            frames.add_frame(frame, models)
+            if self.frame_sink is not None:
+                self.frame_sink(frame, models)
+        out = frames.block(times)
+        frames.forget_before(float(times[-1]))
+        return out
+
+    # ----------------------------------------------- what each way of running SUMO does
+    def _start_sumo(self) -> str:
+        """Start SUMO; the vehicle-type table as JSON."""
+        raise NotImplementedError
+
+    def _next_frame(self) -> Frame:
+        """SUMO's next frame (one step)."""
+        raise NotImplementedError
+
+    def _close_sumo(self) -> bool:
+        """Close SUMO and take its messages; False if it was not running."""
+        raise NotImplementedError
+
+
+class SumoTraffic(LiveSumo):
+    """Vehicles from a SUMO simulation stepped in this process (through libsumo), as a traffic source.
+
+    Args:
+        config, axis, step, begin, end, edges, seed, extra_args, deck_y, demand: the run (:class:`SumoSettings`).
+        half_width: lateral half-width of the deck, m, when ``deck_y`` is not given.
+        frame_sink: where every frame goes (e.g. a log's TrafficLogger), with the vehicle-type table at the
+            start and SUMO's messages at the end (:class:`~cosim.core.traffic.FrameSink`).
+        settings: the run as one value instead (the other arguments but ``frame_sink`` are then not read).
     """
 
     def __init__(
         self,
-        config: str | os.PathLike,
-        axis: BridgeAxis,
+        config: str | os.PathLike | None = None,
+        axis: BridgeAxis | None = None,
         step: float = 0.05,
         begin: float = 0.0,
         end: float = 600.0,
@@ -144,45 +296,35 @@ class SumoTraffic:
         seed: int | None = None,
         half_width: float = 50.0,
         extra_args: Sequence[str] = (),
-        frame_sink: Callable[[Frame, dict[str, VehicleModel]], None] | None = None,
+        frame_sink: FrameSink | None = None,
         deck_y: tuple[float, float] | None = None,
         demand: Demand | None = None,
+        *,
+        settings: SumoSettings | None = None,
     ) -> None:
-        self.config = Path(config)
-        if not self.config.is_file():
-            raise SumoError(f"{self.config}: SUMO config not found")
-        if not step > 0:
-            raise ConfigError(f"traffic `step` must be > 0 s (got {step})")
-        if not end > begin:
-            raise ConfigError(f"traffic `end` ({end} s) must be after `begin` ({begin} s)")
-        self.axis, self.step, self.begin, self.end = axis, float(step), float(begin), float(end)
-        self.seed = seed
-        self.deck_y = (float(deck_y[0]), float(deck_y[1])) if deck_y is not None else (-half_width, half_width)
-        self.half_width = max(abs(self.deck_y[0]), abs(self.deck_y[1]))
-        self._edges_wanted = tuple(edges) if edges else None
-        self.extra_args = tuple(extra_args)
-        self.frame_sink = frame_sink
-        self.demand = demand
-        self.edges: tuple[str, ...] = ()
-        self.lanes: tuple[str, ...] = ()
-        self.deck_lanes: tuple[str, ...] = ()
-        self.reach = WATCH_MARGIN
-        self.models: dict[str, VehicleModel] = {}
-        self.types: dict[str, VehicleType] = {}
-        self.frames: FrameTraffic | None = None
+        if settings is None:
+            if config is None or axis is None:
+                raise ConfigError("SumoTraffic needs a config and an axis (or settings)")
+            settings = SumoSettings(Path(config), axis, step, begin, end, tuple(edges) if edges else None, seed,
+                                    deck_y if deck_y is not None else (-half_width, half_width), tuple(extra_args),
+                                    demand)
+        super().__init__(settings, frame_sink)
+        self.demand = settings.demand
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
         self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
-        self.sumo_steps = 0
-        self.teleports = 0
-        self.messages = ""  # SUMO's own messages, once closed
         self._scratch: Path | None = None
         self._watched: set[str] = set()
         self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
 
-    # ------------------------------------------------------------- lifecycle
-    def start(self) -> SumoTraffic:
+    @property
+    def half_width(self) -> float:
+        return max(abs(self.deck_y[0]), abs(self.deck_y[1]))
+
+    def _start_sumo(self) -> str:
+        import json
+
         import libsumo  # the one place cosim imports libsumo
 
         if self.demand is None:
@@ -205,7 +347,7 @@ class SumoTraffic:
             "--log", str(messages), "--error-log", str(messages),
             "--gui-settings-file", "",  # a GUI-only file (a user's config may name one that is not there)
             *(["--seed", str(self.seed)] if self.seed is not None else []),
-            *self.extra_args,
+            *self.settings.extra_args,
         ]
         self.libsumo = libsumo
         try:
@@ -225,27 +367,15 @@ class SumoTraffic:
                     self._model(type_id)
             self._extend_reach()
             self._trails = AxleTrails(self.reach)
-            attach = getattr(self.frame_sink, "attach", None)
-            if attach is not None:
-                import json
-
-                attach(VEHICLE_TYPES_ATTACHMENT, json.dumps([t.summary() for t in self.table()], indent=1),
-                       "application/json")
         except Exception:
             self.close()
             raise
         self._unit = self.axis.unit()
         self._origin = np.array(self.axis.start, dtype=float)
-        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
-        return self
+        return json.dumps([t.summary() for t in self.table()], indent=1)
 
-    def log_documents(self, attach: Callable[[str, bytes | str, str], None]) -> None:
-        """Attach the vehicle-type table (model, mass, axles and their sources) to a log opened after the start."""
-        import json
-
-        attach(VEHICLE_TYPES_ATTACHMENT, json.dumps([t.summary() for t in self.table()], indent=1), "application/json")
-
-    def close(self) -> None:
+    def _close_sumo(self) -> bool:
+        was_running = self.libsumo is not None or self._scratch is not None
         if self.libsumo is not None:
             try:
                 with _captured_output(self._scratch / "console.txt") if self._scratch else contextlib.nullcontext():
@@ -255,17 +385,8 @@ class SumoTraffic:
             self.libsumo = None
         if self._scratch is not None:
             self.messages = self._read_messages()
-            attach = getattr(self.frame_sink, "attach", None)
-            if attach is not None and self.messages:
-                with contextlib.suppress(Exception):  # the log may already be closed (its own failure)
-                    attach(MESSAGES_FILE, self.messages, "text/plain")
             self._remove_scratch()
-
-    def __enter__(self) -> SumoTraffic:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+        return was_running
 
     def _read_messages(self) -> str:
         assert self._scratch is not None
@@ -313,8 +434,8 @@ class SumoTraffic:
         """The deck's lanes (the named edges', or those through the deck's box); the watched lanes around them."""
         net = net_path(self.config)
         try:
-            if self._edges_wanted is not None:
-                location = locate_bridge(net, self._edges_wanted)
+            if self.settings.edges is not None:
+                location = locate_bridge(net, self.settings.edges)
                 self.edges = (*location.edges, *location.opposite)
                 deck = location.deck_lanes
             else:
@@ -376,9 +497,10 @@ class SumoTraffic:
         typ = vehicle_type(type_id, vt.getVehicleClass(type_id), vt.getLength(type_id), mass, params)
         self.types[type_id] = typ
         self._axles[type_id] = typ.axles
-        self.models.update(typ.axle_models())
-        if len(typ.axles) > 1:
-            self.models[type_id] = typ.model
+        self._known({**dict(typ.axle_models()), **({type_id: typ.model} if len(typ.axles) > 1 else {})})
+
+    def _next_frame(self) -> Frame:
+        return self.advance()
 
     def advance(self) -> Frame:
         """One SUMO step; returns the frame of vehicles near the bridge."""
@@ -446,7 +568,7 @@ class SumoTraffic:
         # (one body, several axles).
         x, y, v, a, keep = axles_on_path(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count,
                                          back, owner, self._origin, *self._unit, self.deck_y, self._x_range,
-                                         (0.0, self.axis.length, 0.0 if self._edges_wanted else BESIDE_DECK))
+                                         (0.0, self.axis.length, 0.0 if self.settings.edges else BESIDE_DECK))
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():
@@ -499,28 +621,6 @@ class SumoTraffic:
                 self.libsumo.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - nothing to undo
                 pass
-
-    def block(self, times: np.ndarray) -> TrafficBlock:
-        """Run SUMO as far as ``times`` (s from ``begin``) need and interpolate the vehicles there."""
-        return follow_frames(self, times, self.advance)
-
-
-def follow_frames(source: Any, times: np.ndarray, next_frame: Callable[[], Frame]) -> TrafficBlock:
-    """The block of a live SUMO source (its ``frames``, ``frame_sink``, ``models``, ``begin``, ``end``, ``step``)
-    at ``times``, taking SUMO's frames from ``next_frame`` (SUMO stepped here or in a child process) as far as
-    they need, each given to the frame sink as it comes."""
-    if source.frames is None:
-        raise SumoError(f"{type(source).__name__}.start() was not called")
-    while source.frames.last_time < times[-1] - 1e-9:
-        if source.begin + source.frames.last_time + source.step > source.end + 1e-9:
-            raise SumoError(f"SUMO's run ends at {source.end} s; the co-simulation asked for {times[-1]} s")
-        frame = next_frame()
-        source.frames.add_frame(frame)
-        if source.frame_sink is not None:
-            source.frame_sink(frame, source.models)
-    out = source.frames.block(times)
-    source.frames.forget_before(float(times[-1]))
-    return out
 
 
 def _first_line(exc: BaseException) -> str:

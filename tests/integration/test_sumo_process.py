@@ -17,10 +17,24 @@ from cosim.errors import ConfigError, SumoError
 from cosim.log.process import fork_possible
 from cosim.run.simulate import build_traffic
 from cosim.run.sumo_process import SumoProcess
-from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks
+from cosim.sumo.adapter import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT, BridgeAxis, SumoTraffic, bundled_networks
 
 pytestmark = pytest.mark.skipif(not fork_possible(), reason="SUMO's process needs Linux and fork")
 AXIS = BridgeAxis((0.0, 0.0), (40.0, 0.0))
+
+
+class _Sink:
+    """A frame sink that keeps what it is given: each frame's time and ids, and the documents' names."""
+
+    def __init__(self) -> None:
+        self.seen: list[tuple[float, tuple[str, ...]]] = []
+        self.documents: list[str] = []
+
+    def __call__(self, frame, models) -> None:  # noqa: ANN001
+        self.seen.append((frame.t, frame.ids))
+
+    def attach(self, name: str, data: bytes | str, media_type: str) -> None:
+        self.documents.append(name)
 
 
 def test_sumo_in_its_own_process_gives_the_same_run_to_the_bit() -> None:
@@ -28,13 +42,14 @@ def test_sumo_in_its_own_process_gives_the_same_run_to_the_bit() -> None:
     bridge = scenario.build_bridge()
     runs, sinks = [], []
     for process in (True, False):
-        seen: list[tuple[float, tuple[str, ...]]] = []
-        with build_traffic(scenario, frame_sink=lambda f, _models, seen=seen: seen.append((f.t, f.ids)),
-                           process=process) as traffic:
+        sink = _Sink()
+        with build_traffic(scenario, frame_sink=sink, process=process) as traffic:
             assert isinstance(traffic, SumoProcess) == process
             runs.append(simulate(bridge, traffic, 30.0, scenario.solver_settings(), scenario.sensors_core(),
                                  road=scenario.build_road(), output_every=scenario.output_every))
-        sinks.append(seen)
+        sinks.append(sink.seen)
+        # One attach implementation for both: the vehicle types at the start, SUMO's messages at the end.
+        assert sink.documents == [VEHICLE_TYPES_ATTACHMENT, MESSAGES_FILE]
     child, here = runs
     assert len(here.vehicle_ids) >= 5 and child.vehicle_ids == here.vehicle_ids
     for name in here.sensors:
@@ -63,7 +78,7 @@ _KILLED_RUN = r"""
 import sys, time
 import numpy as np
 from cosim.run.sumo_process import SumoProcess
-from cosim.sumo.adapter import BridgeAxis, SumoTraffic, bundled_networks
+from cosim.sumo.adapter import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT, BridgeAxis, SumoTraffic, bundled_networks
 traffic = SumoProcess(SumoTraffic(bundled_networks() / "medium.sumocfg", BridgeAxis((0.0, 0.0), (40.0, 0.0)),
                                   end=3600.0, half_width=6.0)).start()
 traffic.block(np.arange(1, 201) * 0.05)
