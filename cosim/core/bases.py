@@ -26,7 +26,19 @@ _EMPTY_2 = np.zeros((0, 0))
 _EMPTY_I = np.zeros(0, dtype=np.int64)
 
 
-class DirectBasis:
+class _Counts:
+    """What both bases count: factorisations of their effective matrix and solves with it."""
+
+    n_factorizations: int
+    n_solves: int
+
+    def count_solves(self, total: int) -> None:
+        """The solves a coupled system's compiled step has done with this basis so far (counted there: the
+        compiled code cannot update this object)."""
+        self.n_solves = int(total)
+
+
+class DirectBasis(_Counts):
     """All free DOFs of the FE model: the full finite-element solution.
 
     Two exact engines solve it (docs/theory.md §6.7-6.8, §12):
@@ -182,7 +194,7 @@ class _CompleteModes:
         return self._m_phi @ f_modal
 
 
-class ModalBasis:
+class ModalBasis(_Counts):
     """A truncated set of mass-normalised modes; the effective matrix is diagonal.
 
     Damping: the bridge's Rayleigh coefficients give each mode

@@ -321,8 +321,10 @@ class BridgeModel:
         return DeckRow(dofs=self._element_dofs(e), values=values)
 
     @cached_property
-    def _deck_coefficients(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per element: polynomial coefficients of w and theta_x (n_el, 14, 4), and lengths."""
+    def deck_coefficients(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per element: the cubic polynomial coefficients in xi of the deck's w (at the shear centre) and of
+        theta_x, per element DOF (n_el, 14, 4), and the element lengths, m (what the compiled step's contact
+        rows evaluate: docs/theory.md §5.1)."""
         lengths, phi_y, phi_z, phi_t = self._element_data
         c_w = np.empty((self.n_elements, ELEMENT_DOFS, 4))
         c_t = np.empty_like(c_w)
@@ -341,7 +343,7 @@ class BridgeModel:
         """
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
-        c_w, c_t, lengths = self._deck_coefficients
+        c_w, c_t, lengths = self.deck_coefficients
         e = np.clip(np.searchsorted(self.nodes_x, x, side="right") - 1, 0, self.n_elements - 1)
         L = lengths[e]
         xi = np.clip((x - self.nodes_x[e]) / L, 0.0, 1.0)

@@ -182,7 +182,7 @@ class CoupledSystem:
         self._state = kernels.BridgeState(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
         self.n_steps = 0
         self._counters = np.zeros(4, dtype=np.int64)  # lift-off events, lift-off steps, solves, diverged
-        c_w, c_t, _ = bridge._deck_coefficients
+        c_w, c_t, _ = bridge.deck_coefficients
         y_min, y_max = bridge.section.deck_y
         tol = _Y_TOL * max(y_max - y_min, 1.0)
         self._y_range = (float(y_min - tol), float(y_max + tol))  # the deck's surface, round-off of lanes allowed
@@ -433,7 +433,7 @@ class CoupledSystem:
         self._step0[0] = self.n_steps + 1  # row k of the block is step n_steps + 1 + k
         kernels.advance_block(arrays, self._deck, self._scheme, self._state, fleet, kin, sensor_rows, out,
                               self._groups)
-        self.basis.n_solves = int(self._counters[2])
+        self.basis.count_solves(int(self._counters[2]))
         if self._counters[3]:
             k = int(self._counters[3])
             self.t += k * self.dt

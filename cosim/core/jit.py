@@ -25,10 +25,17 @@ def _core_stamp() -> tuple[tuple[str, int, int], ...]:
 
 
 def _install_core_locator() -> None:
-    """Register a numba cache locator whose source stamp covers every file of the core."""
-    try:
-        from numba.core.caching import InTreeCacheLocator, _CacheImpl  # type: ignore[attr-defined]
-    except ImportError:  # another numba layout: the per-file stamps still apply
+    """Register a numba cache locator whose source stamp covers every file of the core.
+
+    The one place cosim reaches into numba's private names (``CacheImpl._locator_classes``; the class was
+    ``_CacheImpl`` before numba 0.61): numba has no public way to key a cache on more than the function's own
+    file; tests/unit/test_jit.py fails if they move.
+    """
+    import numba.core.caching as caching
+    from numba.core.caching import InTreeCacheLocator
+
+    impl = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl", None)  # numba >= 0.61 | older
+    if impl is None:  # another numba layout: the per-file stamps still apply (tests/unit/test_jit.py fails)
         return
 
     class CoreTreeLocator(InTreeCacheLocator):
@@ -41,7 +48,7 @@ def _install_core_locator() -> None:
                 return None
             return super().from_function(py_func, py_file)
 
-    locators = getattr(_CacheImpl, "_locator_classes", None)
+    locators = getattr(impl, "_locator_classes", None)
     if isinstance(locators, list) and not any(c.__name__ == "CoreTreeLocator" for c in locators):
         locators.insert(0, CoreTreeLocator)
 

@@ -537,6 +537,35 @@ def _record(step, elems, contact, fleet, groups, out):  # noqa: ANN001, ANN201
         fleet.lifted[i] = now
 
 
+@compiled(inline=True)
+def _deck_dots(kind, idx, rv, i, nnz, u, w, z, with_z):  # noqa: ANN001, ANN201
+    """Contact row i (w, w_x, w_xx: ``rv[i]``) against basis vectors: n0.u, n1.u, n2.u, n0.w, n1.w and, with
+    ``with_z``, n0.z, in one pass over the row. On a modal basis the row holds every mode in order (no index to
+    follow: the loop vectorises); on the direct basis ``idx[i]`` names the unknowns (-1: restrained)."""
+    s0 = s1 = s2 = s3 = s4 = s5 = 0.0
+    if kind == MODAL:
+        for j in range(nnz):
+            s0 += rv[i, 0, j] * u[j]
+            s1 += rv[i, 1, j] * u[j]
+            s2 += rv[i, 2, j] * u[j]
+            s3 += rv[i, 0, j] * w[j]
+            s4 += rv[i, 1, j] * w[j]
+            if with_z:
+                s5 += rv[i, 0, j] * z[j]
+    else:
+        for kk in range(nnz):
+            j = idx[i, kk]
+            if j >= 0:
+                s0 += rv[i, 0, kk] * u[j]
+                s1 += rv[i, 1, kk] * u[j]
+                s2 += rv[i, 2, kk] * u[j]
+                s3 += rv[i, 0, kk] * w[j]
+                s4 += rv[i, 1, kk] * w[j]
+                if with_z:
+                    s5 += rv[i, 0, kk] * z[j]
+    return s0, s1, s2, s3, s4, s5
+
+
 @compiled(nogil=True)
 def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):  # noqa: ANN001, ANN201
     """Advance K = kin.x.shape[0] steps; state, fleet and out are updated in place (docs/theory.md §6).
@@ -598,23 +627,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
         project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
-            s0 = s1 = s2 = s3 = s4 = 0.0
-            if basis.kind == MODAL:  # every mode, in order: no index to follow (the loop vectorises)
-                for j in range(nnz):
-                    s0 += rv[i, 0, j] * d_star[j]
-                    s1 += rv[i, 1, j] * d_star[j]
-                    s2 += rv[i, 0, j] * v_star[j]
-                    s3 += rv[i, 2, j] * d_star[j]
-                    s4 += rv[i, 1, j] * v_star[j]
-            else:
-                for kk in range(nnz):
-                    j = idx[i, kk]
-                    if j >= 0:
-                        s0 += rv[i, 0, kk] * d_star[j]
-                        s1 += rv[i, 1, kk] * d_star[j]
-                        s2 += rv[i, 0, kk] * v_star[j]
-                        s3 += rv[i, 2, kk] * d_star[j]
-                        s4 += rv[i, 1, kk] * v_star[j]
+            s0, s1, s3, s2, s4, _ = _deck_dots(basis.kind, idx, rv, i, nnz, d_star, v_star, v_star, False)
             dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = s0, s1, s2, s3, s4
         if groups.unilateral:
             for j in range(n):
@@ -666,25 +679,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
             return
         # Deck motion at the contact points after the step: n0.a, n1.a, n2.a, n0.d, n0.v + v n1.d.
         for i in range(q):
-            s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-            if basis.kind == MODAL:
-                for j in range(nnz):
-                    s0 += rv[i, 0, j] * a[j]
-                    s1 += rv[i, 1, j] * a[j]
-                    s2 += rv[i, 2, j] * a[j]
-                    s3 += rv[i, 0, j] * d[j]
-                    s4 += rv[i, 0, j] * v[j]
-                    s5 += rv[i, 1, j] * d[j]
-            else:
-                for kk in range(nnz):
-                    j = idx[i, kk]
-                    if j >= 0:
-                        s0 += rv[i, 0, kk] * a[j]
-                        s1 += rv[i, 1, kk] * a[j]
-                        s2 += rv[i, 2, kk] * a[j]
-                        s3 += rv[i, 0, kk] * d[j]
-                        s4 += rv[i, 0, kk] * v[j]
-                        s5 += rv[i, 1, kk] * d[j]
+            s0, s1, s2, s3, s5, s4 = _deck_dots(basis.kind, idx, rv, i, nnz, a, d, v, True)
             dots[5, i], dots[6, i], dots[7, i], dots[8, i] = s0, s1, s2, s3
             dots[9, i] = s4 + kin.v[step, i] * s5
         vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups)

@@ -186,7 +186,7 @@ THEORIES = [BeamTheory(), BENSCOTER, BeamTheory(bending="euler-bernoulli"),
 def test_the_deck_row_is_the_elements_own_for_every_theory(theory):
     """The contact row (5.1) of the compiled loop, the vectorised and the scalar rows, and the deflected shape agree.
 
-    The loop reads the per-element coefficients of BridgeModel._deck_coefficients and the DOFs of
+    The loop reads the per-element coefficients of BridgeModel.deck_coefficients and the DOFs of
     element.DECK_POINT_DOFS; with Benscoter torsion the twist is the interdependent field of §10.3.
     """
     from cosim.core import kernels
@@ -198,7 +198,7 @@ def test_the_deck_row_is_the_elements_own_for_every_theory(theory):
     res = bridge.static([PointLoad(4.1, 0.25, -1e5), PointLoad(12.3, -0.2, -5e4)])
     x = np.array([0.7, 4.1, 9.99, 12.3, 15.6])
     y = np.array([0.25, -0.3, 0.1, -0.2, 0.3])
-    c_w, c_t, _ = bridge._deck_coefficients
+    c_w, c_t, _ = bridge.deck_coefficients
     deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
                               float(section.y_s), float(bridge.length), np.array(DECK_POINT_DOFS, dtype=np.int64),
                               NODE_DOFS)
