@@ -42,6 +42,12 @@ class Interrupted(KeyboardInterrupt):
         self.name = name
 
 
+def first_line(exc: BaseException) -> str:
+    """An exception's message as one line (its first), or its type's name if it says nothing: for reporting
+    a third-party error (SUMO's, a parser's) inside a message of cosim's own."""
+    return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+
+
 def interruption(exc: BaseException) -> tuple[int, str]:
     """(signal number, name) of an interruption: an :class:`Interrupted`, or a bare KeyboardInterrupt (SIGINT)."""
     if isinstance(exc, Interrupted):

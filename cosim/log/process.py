@@ -110,7 +110,8 @@ def fork_child(name: str, target: Callable[..., None], args: tuple, child_ends: 
     return process
 
 
-def _first_line(exc: BaseException) -> str:
+def _where_and_what(exc: BaseException) -> str:
+    """The child's error for the run: its type, message and where it was raised (file:line)."""
     where = traceback.extract_tb(exc.__traceback__)
     at = f" ({Path(where[-1].filename).name}:{where[-1].lineno})" if where else ""
     return f"{type(exc).__name__}: {exc}{at}"
@@ -122,7 +123,7 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
     try:
         rec = LogRecorder(path, names, force=False, scene=scene)
     except BaseException as exc:  # noqa: BLE001 - reported to the run, which raises it
-        replies.send(("error", str(exc) if isinstance(exc, LogError) else _first_line(exc)))
+        replies.send(("error", str(exc) if isinstance(exc, LogError) else _where_and_what(exc)))
         return
     replies.send(("ready", None))
     logger: BlockLogger | None = None
@@ -143,7 +144,7 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
                     logger.close()
                 rec.close(*message[1:])
             except BaseException as exc:  # noqa: BLE001
-                error = error or _first_line(exc)
+                error = error or _where_and_what(exc)
             replies.send(("closed", error))
             return
         if error is not None:
@@ -165,7 +166,7 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
             else:
                 getattr(rec, op)(*message[1:])
         except BaseException as exc:  # noqa: BLE001 - reported to the run at its next block
-            error = _first_line(exc)
+            error = _where_and_what(exc)
             with contextlib.suppress(OSError):
                 replies.send(("error", error))
 

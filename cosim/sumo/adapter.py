@@ -48,7 +48,7 @@ import numpy as np
 from cosim.core.axle_paths import AxleTrails, axles_on_path, path_behind, record_fronts
 from cosim.core.traffic import Frame, FrameSink, FrameTraffic, TrafficBlock, TrafficSource
 from cosim.core.vehicles import VehicleModel
-from cosim.errors import ConfigError, SumoError
+from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
 from cosim.sumo.vtypes import VehicleType, vehicle_type
@@ -355,7 +355,7 @@ class SumoTraffic(LiveSumo):
                 libsumo.start(cmd)
         except Exception as exc:  # libsumo raises its own error types; SUMO said why on its console
             self.libsumo = None
-            reason = self._sumo_error() or _first_line(exc)
+            reason = self._sumo_error() or first_line(exc)
             self._remove_scratch()
             raise SumoError(f"{self.config}: SUMO could not load it: {reason}") from None
         try:
@@ -509,7 +509,7 @@ class SumoTraffic(LiveSumo):
             ls.simulationStep()
             self.teleports += ls.simulation.getStartingTeleportNumber()
         except Exception as exc:  # noqa: BLE001 - SUMO errors come as several libsumo exception types
-            raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {_first_line(exc)}") \
+            raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {first_line(exc)}") \
                 from None
         self.sumo_steps += 1
         t = self.sumo_steps * self.step
@@ -621,8 +621,3 @@ class SumoTraffic(LiveSumo):
                 self.libsumo.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - nothing to undo
                 pass
-
-
-def _first_line(exc: BaseException) -> str:
-    text = str(exc).strip() or type(exc).__name__
-    return text.splitlines()[0]

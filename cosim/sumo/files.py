@@ -70,7 +70,10 @@ GZIP_MAGIC = b"\x1f\x8b"
 
 
 def number_text(value: float) -> str:
-    """500.0 -> "500", 0.1 -> "0.1": the shortest text that reads back as the same number."""
+    """500.0 -> "500", 0.1 -> "0.1": the shortest text that reads back as the same number.
+
+    cosim's one number formatter (SUMO files, study run ids, error messages): exact, never rounded, so two
+    different values never print alike and a bound in a message never contradicts the value it reports."""
     value = float(value)
     if value.is_integer() and abs(value) < 1e15:
         return str(int(value))

@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.errors import ConfigError
+from cosim.errors import ConfigError, first_line
 from cosim.sumo.files import read_config, read_input
 
 __all__ = [
@@ -150,15 +150,11 @@ def _read_network(path: str, size: int, mtime_ns: int) -> Any:
         parser.setContentHandler(reader)
         parser.parse(io.BytesIO(data))
     except (xml.sax.SAXException, ValueError, KeyError, IndexError) as exc:
-        raise ConfigError(f"{path}: not a readable SUMO network ({_one_line(exc)})") from None
+        raise ConfigError(f"{path}: not a readable SUMO network ({first_line(exc)})") from None
     net = reader.getNet()
     if not net.getEdges():
         raise ConfigError(f"{path}: the network has no edges")
     return net
-
-
-def _one_line(exc: BaseException) -> str:
-    return (str(exc).strip().splitlines() or [type(exc).__name__])[0]
 
 
 # --------------------------------------------------------------------------- lanes
