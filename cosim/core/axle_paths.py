@@ -37,6 +37,7 @@ SUMO's 0.05 s step), R = 12 m (a tight junction turn), b = 14 m.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 import numpy.typing as npt
@@ -50,6 +51,14 @@ STRAIGHT_TOLERANCE = 1e-3
 MIN_SPACING = 0.25
 #: Trail points beyond those that cover the reach, per vehicle (a seeded lane's vertices).
 SPARE_POINTS = 64
+
+
+#: The trails as the compiled passes take them: per slot (vehicle) the bumper points px, py (m, network) and the
+#: distance driven to each, s (m), in a ring of ``capacity`` points (``head``: the newest, ``count``: how many),
+#: and the speed at the newest, m/s.
+TrailArrays = namedtuple("TrailArrays", ["px", "py", "s", "head", "count", "speed"])
+#: The bridge axis in network coordinates: its start (m), the unit vectors along it and to its left.
+AxisFrame = namedtuple("AxisFrame", ["origin", "along", "left"])
 
 
 def trail_capacity(reach: float) -> int:
@@ -127,19 +136,24 @@ class AxleTrails:
         self.s[k, :n] = -np.asarray(behind[-n:], dtype=float)
         self.head[k], self.count[k], self.speed[k] = n - 1, n, speed
 
+    @property
+    def arrays(self) -> TrailArrays:
+        """The trails for the compiled passes (new arrays after a resize: take them anew each time)."""
+        return TrailArrays(self.px, self.py, self.s, self.head, self.count, self.speed)
+
     def slots(self, vehicles: list[str]) -> npt.NDArray[np.int64]:
         """The slot of each vehicle (all added)."""
         return np.array([self.slot_of[v] for v in vehicles], dtype=np.int64)
 
 
 @compiled
-def record_fronts(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
-                  head: np.ndarray, count: np.ndarray, speed: np.ndarray, step: float) -> None:
+def record_fronts(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, step: float) -> None:
     """Append every vehicle's bumper (``vehicles`` rows: x, y (m), heading, speed (m/s), ...) to its trail, one
     traffic step (``step``, s) after the last: the distance driven since the last point is the bumper's move,
     at most the travel of the mean speed over the step (a lane change's sideways jump adds nothing; on a
     curve it is the chord). The newest point is always the bumper; it replaces the newest kept point while
     that lies less than :data:`MIN_SPACING` after the one before it."""
+    px, py, s, head, count, speed = trails
     cap = px.shape[1]
     for r in range(vehicles.shape[0]):
         k = slots[r]
@@ -161,9 +175,8 @@ def record_fronts(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
 
 
 @compiled
-def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
-                  head: np.ndarray, count: np.ndarray, back: np.ndarray, owner: np.ndarray, origin: np.ndarray,
-                  along: np.ndarray, left: np.ndarray, y_range: tuple[float, float], x_range: tuple[float, float],
+def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, back: np.ndarray, owner: np.ndarray,
+                  axis: AxisFrame, y_range: tuple[float, float], x_range: tuple[float, float],
                   span: tuple[float, float, float]
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Contact points of vehicles in bridge coordinates, each axle on its vehicle's trail (module docstring).
@@ -172,9 +185,9 @@ def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
         vehicles: (n, 5 or more) per vehicle: front bumper x, y (m, network), heading (degrees, 0 = north,
             clockwise: SUMO's angle), speed (m/s), acceleration (m/s^2), both along the heading; columns after
             these are not read.
-        slots, px, py, s, head, count: each vehicle's trail (:class:`AxleTrails`, its bumper recorded).
+        slots, trails: each vehicle's slot and the trails (:class:`AxleTrails`, its bumper recorded).
         back: (m,) each contact point's distance behind the bumper, m; owner: (m,) its vehicle's row.
-        origin: the bridge axis' start (network, m); along, left: unit vectors along the axis and to its left.
+        axis: the bridge axis' start (network, m) and the unit vectors along it and to its left.
         y_range, x_range: the region kept, m (bridge coordinates: the deck's width, the watched reach).
         span: (x_min, x_max, margin): over this stretch of the axis (the deck's length), contact points up to
             ``margin`` m beyond ``y_range`` are kept too (a wheel beside the deck is seen, not lost).
@@ -184,6 +197,8 @@ def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
         direction there), and whether it is kept: every contact point of a vehicle with any contact point in
         the region (one body on several axles).
     """
+    px, py, s, head, count, _ = trails
+    origin, along, left = axis
     m = len(back)
     cap = px.shape[1]
     x, y, v, a = np.empty(m), np.empty(m), np.empty(m), np.empty(m)

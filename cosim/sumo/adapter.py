@@ -45,7 +45,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.axle_paths import AxleTrails, axles_on_path, path_behind, record_fronts
+from cosim.core.axle_paths import AxisFrame, AxleTrails, axles_on_path, path_behind, record_fronts
 from cosim.core.traffic import Frame, FrameSink, FrameTraffic, TrafficBlock, TrafficSource
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
@@ -371,7 +371,7 @@ class SumoTraffic(LiveSumo):
             self.close()
             raise
         self._unit = self.axis.unit()
-        self._origin = np.array(self.axis.start, dtype=float)
+        self._axis_frame = AxisFrame(np.array(self.axis.start, dtype=float), *self._unit)
         return json.dumps([t.summary() for t in self.table()], indent=1)
 
     def _close_sumo(self) -> bool:
@@ -549,8 +549,7 @@ class SumoTraffic(LiveSumo):
                 trails.add(vid)
                 self._seed_trail(vid, num[j])
         slots = trails.slots(ids)
-        record_fronts(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count, trails.speed,
-                      self.step)
+        record_fronts(num, slots, trails.arrays, self.step)
         vehicles = ids
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(rows))
@@ -566,9 +565,9 @@ class SumoTraffic(LiveSumo):
         # Axles on the deck's width (or beside it, over its length) and within the watched reach along it (a
         # vehicle on a long lane after the deck is dropped once far from it); a vehicle's axles stay together
         # (one body, several axles).
-        x, y, v, a, keep = axles_on_path(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count,
-                                         back, owner, self._origin, *self._unit, self.deck_y, self._x_range,
-                                         (0.0, self.axis.length, 0.0 if self.settings.edges else BESIDE_DECK))
+        beside = 0.0 if self.settings.edges else BESIDE_DECK
+        x, y, v, a, keep = axles_on_path(num, slots, trails.arrays, back, owner, self._axis_frame, self.deck_y,
+                                         self._x_range, (0.0, self.axis.length, beside))
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():

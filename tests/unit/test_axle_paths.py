@@ -8,6 +8,7 @@ import numpy as np
 
 from cosim.core.axle_paths import (
     MIN_SPACING,
+    AxisFrame,
     AxleTrails,
     axles_on_path,
     path_behind,
@@ -15,8 +16,7 @@ from cosim.core.axle_paths import (
     trail_capacity,
 )
 
-ORIGIN = np.zeros(2)
-ALONG, LEFT = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+AXIS = AxisFrame(np.zeros(2), np.array([1.0, 0.0]), np.array([0.0, 1.0]))  # the network's x axis
 WIDE = (-1e6, 1e6)
 STEP = 0.05  # s, the traffic step the drives below are recorded at
 
@@ -38,9 +38,8 @@ def _drive(trails: AxleTrails, states: list[tuple[float, float, float]], back: l
     for x, y, angle in states:
         num = np.array([[x, y, angle, speed, 0.5, 20.0]])
         slots = trails.slots(["v"])
-        record_fronts(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count, trails.speed, STEP)
-        out.append(axles_on_path(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count, back_a,
-                                 owner, ORIGIN, ALONG, LEFT, WIDE, WIDE, (0.0, 0.0, 0.0)))
+        record_fronts(num, slots, trails.arrays, STEP)
+        out.append(axles_on_path(num, slots, trails.arrays, back_a, owner, AXIS, WIDE, WIDE, (0.0, 0.0, 0.0)))
     return out
 
 
@@ -58,9 +57,8 @@ def test_axles_are_projected_onto_a_rotated_axis_and_kept_with_their_vehicle() -
     trails.add("truck")
     trails.add("car")
     slots = trails.slots(["truck", "car"])
-    record_fronts(vehicles, slots, trails.px, trails.py, trails.s, trails.head, trails.count, trails.speed, STEP)
-    args = (vehicles, slots, trails.px, trails.py, trails.s, trails.head, trails.count, back, owner, origin, along,
-            left, (-5.0, 5.0))
+    record_fronts(vehicles, slots, trails.arrays, STEP)
+    args = (vehicles, slots, trails.arrays, back, owner, AxisFrame(origin, along, left), (-5.0, 5.0))
     x, y, v, a, keep = axles_on_path(*args, (-12.0, 52.0), (0.0, 0.0, 0.0))
     # Reference: by hand, the axles lie on the axis at 20 - 1.2 and 20 - 8 m, the car's contact at 70 + 2.25 m.
     np.testing.assert_allclose(x, [18.8, 12.0, 72.25], atol=1e-12)
@@ -174,8 +172,7 @@ def test_trails_grow_for_longer_vehicles_and_keep_what_they_hold() -> None:
     for k in range(20):
         slot = trails.slots([f"v{k}"])
         for x, y, angle in states:
-            record_fronts(np.array([[x, y, angle, 2 * MIN_SPACING / STEP]]), slot, trails.px, trails.py, trails.s,
-                          trails.head, trails.count, trails.speed, STEP)
+            record_fronts(np.array([[x, y, angle, 2 * MIN_SPACING / STEP]]), slot, trails.arrays, STEP)
     before = trails.s[trails.slot_of["v7"], :10].copy()
     trails.ensure_reach(60.0)
     assert trails.capacity == trail_capacity(60.0)
