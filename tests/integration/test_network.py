@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from cosim.cli import main
-from cosim.log import read_log
+from cosim.log import read_log, sensor_series
 from cosim.log.schemas import TOPIC_EVENTS, TOPIC_VEHICLES
 from cosim.run.logged import run_logged
 from cosim.run.scenario import load_scenario
@@ -189,6 +189,24 @@ def test_every_axle_of_a_five_axle_lorry_crosses_from_one_deck_end_to_the_other_
         gap = np.interp(t_mid, t0[axles[k + 1]], x0[axles[k + 1]]) - np.interp(t_mid, t0[axles[k]], x0[axles[k]])
         assert gap == pytest.approx(spacing, abs=0.05)
     assert not [m for m in log.topic(TOPIC_EVENTS) if m["event"] == "liftoff"]
+
+
+def test_the_run_is_as_before_axles_followed_their_trail_until_the_lorry_turns_onto_the_deck(west):
+    """Issue 23: the junction bridge's results change only where a vehicle turns. Reference: this run's mid-span
+    deflection before the axles followed their vehicle's path (tests/data/bologna/west-before-trails.npz,
+    written by commit d8217b2's code), with the time its turning lorry's first axle reached the deck then. The
+    series is the same to the bit until that moment; the lorry turns from edge 32 onto the deck at its x = L end,
+    and with its axles on its lane (not on the line behind its turned bumper) they reach the deck 0.1 s later.
+    After, the series stays within 2.5 % of its peak (measured: 2.2 %)."""
+    before = np.load(DATA / "west-before-trails.npz")
+    t, series = sensor_series(west["path"], ["mid"])
+    now, old = series["mid"], before["mid"]
+    assert np.array_equal(t, before["t"])
+    changed = np.flatnonzero(now != old)
+    assert changed.size and t[changed[0]] >= float(before["lorry_entered"]) - 1e-9
+    entered = [m["t"] for m in west["log"].topic(TOPIC_EVENTS) if m["vehicle"] == "lorry#0" and m["event"] == "entered"]
+    assert 0.0 < entered[0] - float(before["lorry_entered"]) < 0.2
+    assert np.max(np.abs(now - old)) <= 0.025 * np.max(np.abs(old))
 
 
 def test_traffic_crosses_in_both_directions_and_left_events_carry_the_exit_position(west):
