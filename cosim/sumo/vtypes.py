@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 
 from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
 from cosim.errors import ConfigError, SumoError
@@ -233,11 +233,8 @@ def axles_from_parameters(type_id: str, length: float, params: dict[str, str]) -
 
 
 def scaled_model(model: VehicleModel, share: float) -> VehicleModel:
-    """The part of ``model`` carried by one axle: masses, stiffnesses and dampings times ``share``."""
-    if isinstance(model, MovingForce):
-        return MovingForce(model.mass * share)
-    scaled = {k: v * share for k, v in asdict(model).items() if isinstance(v, float | int) and not isinstance(v, bool)}
-    return replace(model, **scaled)  # type: ignore[arg-type]  # switches (unilateral contact) stay as they are
+    """The part of ``model`` carried by one axle (:meth:`~cosim.core.vehicles.VehicleModel.scaled`)."""
+    return model.scaled(share)
 
 
 @dataclass(frozen=True)
