@@ -170,7 +170,8 @@ class SumoTraffic:
         self.models: dict[str, VehicleModel] = {}
         self.types: dict[str, VehicleType] = {}
         self.frames: FrameTraffic | None = None
-        self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
+        self._axles: dict[str, tuple[tuple[float, float], ...]] = {}  # per contact: behind the bumper, left, m
+        self._sideways: set[str] = set()  # the types with a contact point beside the path (left != 0)
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
         self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
@@ -375,9 +376,12 @@ class SumoTraffic:
         params = entry.params if entry is not None else {}
         typ = vehicle_type(type_id, vt.getVehicleClass(type_id), vt.getLength(type_id), mass, params)
         self.types[type_id] = typ
-        self._axles[type_id] = typ.axles
-        self.models.update(typ.axle_models())
-        if len(typ.axles) > 1:
+        columns = typ.contact_columns()
+        self._axles[type_id] = tuple((back, left) for _, _, back, left in columns)
+        if any(left for _, left in self._axles[type_id]):
+            self._sideways.add(type_id)
+        self.models.update((key, model) for key, model, _, _ in columns)
+        if len(columns) > 1:
             self.models[type_id] = typ.model
 
     def advance(self) -> Frame:
@@ -429,7 +433,7 @@ class SumoTraffic:
         slots = trails.slots(ids)
         record_fronts(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count, trails.speed,
                       self.step)
-        vehicles = ids
+        vehicles, vtypes = ids, types
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(rows))
             back = 0.5 * num[:, 5]
@@ -447,6 +451,12 @@ class SumoTraffic:
         x, y, v, a, keep = axles_on_path(num, slots, trails.px, trails.py, trails.s, trails.head, trails.count,
                                          back, owner, self._origin, *self._unit, self.deck_y, self._x_range,
                                          (0.0, self.axis.length, 0.0 if self._edges_wanted else BESIDE_DECK))
+        if self._sideways and not self._sideways.isdisjoint(vtypes):  # wheels beside the path: across the axis
+            left = np.array([side for typ in vtypes for _, side in self._axles[typ]])
+            heading = np.radians(num[:, 2])
+            along = self._unit[0]
+            ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
+            y = y + ahead[owner] * left
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():
