@@ -177,16 +177,16 @@ def _log_target(out: str | None, default: Path, force: bool) -> Path:
     return path
 
 
-_PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m",
-                    "m_b": "kg", "i_b": "kg m^2", "cg": "m"}
-
-
-def _parameter_text(key: str, value: Any) -> str:
+def _parameter_text(key: str, value: Any, unit: str) -> str:
     if key == "axles":
         return f"{len(value)} axles at {', '.join(fmt_g(a.distance) for a in value)} m"
     if key == "pitch":
         return "pitch" if value else "no pitch"
-    return f"{key} = {fmt_g(value)} {_PARAMETER_UNITS[key]}"
+    if isinstance(value, bool):
+        return f"{key} = {'true' if value else 'false'}"
+    if isinstance(value, tuple):
+        return f"{len(value)} {key}"
+    return f"{key} = {fmt_g(value)} {unit}".rstrip()
 
 
 def _traffic_line(scenario: Scenario, plan: SumoPlan | None = None) -> str:
@@ -243,7 +243,7 @@ def _vehicle_lines(scenario: Scenario, plan: SumoPlan | None = None) -> list[str
             speed = "profile " + " ".join(f"{fmt_g(t)}s:{fmt_g(vv)}" for t, vv in v.profile)
         else:
             speed = fmt_g(v.speed or 0.0)
-        params = ", ".join(_parameter_text(k, val) for k, val in v.parameters.items())
+        params = ", ".join(_parameter_text(k, val, v.spec.parameter(k).unit) for k, val in v.parameters.items())
         if v.contact == "unilateral":
             params += ", unilateral contact"
         rows.append((v.id, v.model, f"{v.y:.3f}", v.direction, speed, fmt_g(v.entry_time), params))

@@ -45,8 +45,7 @@ from .roughness import RoadProfile, smooth_road
 from .schemes import Scheme
 from .sensors import TIME_DERIVATIVE, Sensor, check_sensor_on, sensor_row
 from .traffic import AXLE_SEPARATOR, TrafficBlock, TrafficFrame, vehicle_of
-from .vehicles import MODELS, PARAM_ROWS, STATE_ROWS, VehicleModel
-from .vehicles.base import LINEAR
+from .vehicles import KERNEL_KINDS, LINEAR, MODELS, PARAM_ROWS, STATE_ROWS, VehicleModel
 
 #: Lateral tolerance of "on the deck" for a wheel path, relative to the deck width.
 _Y_TOL = 1e-9
@@ -79,22 +78,35 @@ class BlockReport:
     off_surface: npt.NDArray[np.bool_] | None = None
 
 
-def _fleet_parameters(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray,
-                                                                                          np.ndarray]:
-    """Compiled kind, parameters (PARAM_ROWS, q) and total mass (q,) of the vehicles (contact columns)."""
+def _fleet_parameters(models: tuple[VehicleModel, ...], columns: list[list[int]],
+                      gravity: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compiled kind, parameters (PARAM_ROWS, q) and static load (N, q) of the contact columns (``columns``: each
+    vehicle's, :func:`_vehicle_columns`). A linear vehicle's loads are set with its matrices (:meth:`_sync`)."""
     q = len(models)
     kind = np.empty(q, dtype=np.int64)
     params = np.zeros((PARAM_ROWS, q))
-    mass = np.empty(q)
+    weight = np.empty(q)
     for j, m in enumerate(models):
-        if type(m) not in MODELS.values():
-            raise ConfigError(f"vehicle {ids[j]}: unknown vehicle model {type(m).__name__} "
-                              f"(expected one of: {', '.join(MODELS)})")
         kind[j] = m.kernel_kind
         packed = m.pack()
         params[: len(packed), j] = packed
-        mass[j] = m.total_mass
-    return kind, params, mass
+        weight[j] = m.total_mass * gravity  # one contact carries the weight
+    for cols in columns:
+        model = models[cols[0]]
+        if len(cols) > 1 and model.kernel_kind != LINEAR:
+            weight[cols] = model.static_axle_loads(gravity)
+    return kind, params, weight
+
+
+def _check_models(models: tuple[VehicleModel, ...], ids: tuple[str, ...]) -> None:
+    """Raise ConfigError for a column whose model is not a vehicle model the compiled loop can run."""
+    for j, m in enumerate(models):
+        if not isinstance(m, VehicleModel):
+            raise ConfigError(f"vehicle {ids[j]}: unknown vehicle model {type(m).__name__} "
+                              f"(expected one of: {', '.join(MODELS)})")
+        if m.kernel_kind not in KERNEL_KINDS:
+            raise ConfigError(f"vehicle {ids[j]}: model {m.kind} has kernel kind {m.kernel_kind}, which the "
+                              f"compiled loop does not know ({', '.join(map(str, KERNEL_KINDS))})")
 
 
 @dataclass
@@ -106,23 +118,22 @@ class _LinearVehicle:
     flying: np.ndarray  # per contact
 
 
-def _linear_groups(ids: tuple[str, ...], models: tuple[VehicleModel, ...], kind: np.ndarray) -> list[list[int]]:
-    """Columns of each linear vehicle: consecutive columns of one vehicle ("v#0", "v#1", ...) sharing a model."""
+def _vehicle_columns(ids: tuple[str, ...], models: tuple[VehicleModel, ...]) -> list[list[int]]:
+    """Each vehicle's contact columns: one for a one-contact model, else consecutive columns "v#0", "v#1", ...
+    sharing a model (its contact points, in order)."""
     groups: list[list[int]] = []
     j = 0
     while j < len(ids):
-        if kind[j] != LINEAR:
-            j += 1
-            continue
         model = models[j]
-        count = getattr(model, "contacts", 1)
+        count = model.contacts
         cols = list(range(j, j + count))
-        owner = vehicle_of(ids[j])
-        expected = [f"{owner}{AXLE_SEPARATOR}{k}" for k in range(count)] if count > 1 else [ids[j]]
-        if len(ids) < j + count or [ids[c] for c in cols] != expected or \
-                any(models[c] != model for c in cols):
-            raise ConfigError(f"vehicle {owner}: its {count} axles must come together as {', '.join(expected)} "
-                              "(one contact column per axle, in order, with the same model)")
+        if count > 1:
+            owner = vehicle_of(ids[j])
+            expected = [f"{owner}{AXLE_SEPARATOR}{k}" for k in range(count)]
+            if len(ids) < j + count or [ids[c] for c in cols] != expected or \
+                    any(models[c] != model for c in cols):
+                raise ConfigError(f"vehicle {owner}: its {count} axles must come together as {', '.join(expected)} "
+                                  "(one contact column per axle, in order, with the same model)")
         groups.append(cols)
         j += count
     return groups
@@ -311,8 +322,9 @@ class CoupledSystem:
         q = len(block.ids)
         vstate = np.zeros((STATE_ROWS, q))
         lifted = np.zeros(q, dtype=bool)
-        kind, params, mass = _fleet_parameters(block.models, block.ids)
-        weight = mass * self.gravity
+        _check_models(block.models, block.ids)
+        columns = _vehicle_columns(block.ids, block.models)
+        kind, params, weight = _fleet_parameters(block.models, columns, self.gravity)
         for j, vid in enumerate(block.ids):
             if vid in old:
                 vstate[:, j] = self._vstate[:, old[vid]]
@@ -320,7 +332,7 @@ class CoupledSystem:
             else:
                 level = self._level(float(block.x[0, j]), float(block.y[j]))
                 vstate[0, j] = vstate[3, j] = level
-        group_cols = _linear_groups(block.ids, block.models, kind)
+        group_cols = [cols for cols in columns if kind[cols[0]] == LINEAR]
         present = set()
         for cols in group_cols:
             owner = vehicle_of(block.ids[cols[0]]) if len(cols) > 1 else block.ids[cols[0]]
@@ -330,7 +342,7 @@ class CoupledSystem:
                 self._linear[owner] = self._new_linear(model, block, cols)
             system = self._linear[owner].system
             for k, c in enumerate(cols):
-                params[:3, c] = system["k_t"][k], system["c_t"][k], 1.0 if getattr(model, "unilateral", False) else 0.0
+                params[:3, c] = system["k_t"][k], system["c_t"][k], 1.0 if model.unilateral else 0.0
                 weight[c] = system["loads"][k]
         self._linear = {k: v for k, v in self._linear.items() if k in present}
         self.ids, self._kind, self._params, self._weight = block.ids, kind, params, weight
@@ -345,7 +357,10 @@ class CoupledSystem:
 
     def _new_linear(self, model: VehicleModel, block: TrafficBlock, cols: list[int]) -> _LinearVehicle:
         """A linear vehicle arriving: its matrices and its static equilibrium on the road under its wheels."""
-        system = model.linear_system(self.gravity)  # type: ignore[union-attr]  # LINEAR models have one
+        system = model.linear_system(self.gravity)
+        if system is None:
+            raise ConfigError(f"vehicle {vehicle_of(block.ids[cols[0]])}: model {model.kind} has the LINEAR kernel "
+                              "kind but no linear system")
         levels = np.array([self._level(float(block.x[0, c]), float(block.y[c])) for c in cols])
         b, k_t = system["b"], system["k_t"]
         k_total = system["kv"] + (b.T * k_t) @ b
@@ -386,7 +401,7 @@ class CoupledSystem:
             a_at += nz + nz * nc + nc + nc * nc
             col[cols] = g
             flying[cols] = vehicle.flying
-            unilateral = unilateral or bool(getattr(block.models[cols[0]], "unilateral", False))
+            unilateral = unilateral or block.models[cols[0]].unilateral
         return kernels.GroupArrays(
             np.array(first, dtype=np.int64), np.array(ncont, dtype=np.int64), np.array(nzs, dtype=np.int64),
             np.array(moff, dtype=np.int64), np.concatenate(mats), np.array(soff, dtype=np.int64),

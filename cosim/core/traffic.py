@@ -28,7 +28,7 @@ import numpy.typing as npt
 from cosim.errors import ConfigError
 
 from .jit import compiled
-from .vehicles import MODELS, VehicleModel
+from .vehicles import VehicleModel, model_classes
 
 AXLE_SEPARATOR = "#"
 
@@ -166,9 +166,10 @@ class ScriptedVehicle:
     def __post_init__(self) -> None:
         if not isinstance(self.id, str) or not self.id:
             raise ConfigError(f"vehicle {self.id!r}: `id` must be a non-empty string")
-        if type(self.model) not in MODELS.values():
+        if not isinstance(self.model, VehicleModel):
             raise ConfigError(f"vehicle {self.id}: `model` must be one of the vehicle models "
-                              f"({', '.join(c.__name__ for c in MODELS.values())}), got {type(self.model).__name__}")
+                              f"({', '.join(c.__name__ for c in model_classes().values())}), "
+                              f"got {type(self.model).__name__}")
         for key in ("y", "speed", "entry_time"):
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
@@ -229,9 +230,10 @@ class ScriptedTraffic(TrafficSource):
     def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         """The vehicles on the deck at any of ``times`` (s), with their kinematics at each.
 
-        A vehicle with several axles (a :class:`~cosim.core.vehicles.HalfCar`) is
-        one column per axle, ``<id>#<k>``, the axles following its front axle; it is
-        in the block, all axles together, while any of them is on the deck.
+        A vehicle with several contact points (a :class:`~cosim.core.vehicles.HalfCar`'s axles) is
+        one column per point, ``<id>#<k>``, each its distance behind the front one and its offset to
+        the left of the path (the vehicle's own left: -y when it drives along -x); it is in the block,
+        all points together, while any of them is on the deck.
         """
         times = np.asarray(times, dtype=float)
         if any(veh.model.contacts > 1 for veh in self.vehicles):
@@ -258,28 +260,28 @@ class ScriptedTraffic(TrafficSource):
         )
 
     def _axle_block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
-        """:meth:`block` with a column per axle (multi-axle models)."""
+        """:meth:`block` with a column per contact point (models with several)."""
         ids: list[str] = []
         models: list[VehicleModel] = []
         xs, vs, accs, ys = [], [], [], []
         for veh in self.vehicles:
             dist, speed, acc = veh.distance(times - veh.entry_time)
             entered = times >= veh.entry_time
-            offsets = veh.model.contact_offsets
+            points = veh.model.contact_points
             cols = []
-            for off in offsets:  # axle k is `off` behind the front axle
-                s = np.where(entered, dist - off, np.minimum(dist - off, -1e-9))
+            for point in points:  # contact k is `behind` the front one
+                s = np.where(entered, dist - point.behind, np.minimum(dist - point.behind, -1e-9))
                 cols.append(s if veh.direction > 0 else self.length - s)
             x_axles = np.stack(cols, axis=1)
             if not on_deck(x_axles, self.length).any():
                 continue
-            names = [f"{veh.id}{AXLE_SEPARATOR}{k}" for k in range(len(offsets))] if len(offsets) > 1 else [veh.id]
-            ids += names
-            models += [veh.model] * len(offsets)
+            n = len(points)
+            ids += [f"{veh.id}{AXLE_SEPARATOR}{k}" for k in range(n)] if n > 1 else [veh.id]
+            models += [veh.model] * n
             xs.append(x_axles)
-            vs.append(np.repeat((veh.direction * speed)[:, None], len(offsets), axis=1))
-            accs.append(np.repeat((veh.direction * acc)[:, None], len(offsets), axis=1))
-            ys += [veh.y] * len(offsets)
+            vs.append(np.repeat((veh.direction * speed)[:, None], n, axis=1))
+            accs.append(np.repeat((veh.direction * acc)[:, None], n, axis=1))
+            ys += [veh.y + veh.direction * p.left if p.left else veh.y for p in points]
         k = len(times)
         stack = (lambda parts: np.concatenate(parts, axis=1)) if xs else (lambda parts: np.zeros((k, 0)))
         return TrafficBlock(tuple(ids), tuple(models), stack(xs), stack(vs), stack(accs), np.array(ys, dtype=float))
@@ -455,7 +457,7 @@ class FrameTraffic(TrafficSource):
         ids = list(index)
         wanted = on.any(axis=0)
         models = self._models
-        if any(getattr(models[type_of[c]], "contacts", 1) > 1 for c in np.flatnonzero(wanted).tolist()):
+        if any(models[type_of[c]].contacts > 1 for c in np.flatnonzero(wanted).tolist()):
             wanted = self._whole_vehicles(ids, wanted)
         keep = np.flatnonzero(wanted)
         X, V, A = X[:, keep], V[:, keep], A[:, keep]

@@ -495,7 +495,7 @@ class SceneWriter:
             groups: dict[str, list[int]] = {}
             for j, contact in enumerate(report.ids):
                 groups.setdefault(vehicle_of(contact), []).append(j)
-            heavy = {owner: len(cols) > 1 or max(getattr(report.models[j], "total_mass", 0.0) for j in cols) > HEAVY_KG
+            heavy = {owner: len(cols) > 1 or max(report.models[j].total_mass for j in cols) > HEAVY_KG
                      for owner, cols in groups.items()}
         datas: list[bytes] = []
         stamp_of = list(zip(seconds.tolist(), nanoseconds.tolist()))

@@ -191,52 +191,52 @@ _TYPE_EXPECTED = {
 _BOUNDS = {"greater_than": ">", "greater_than_equal": ">=", "less_than": "<", "less_than_equal": "<="}
 
 
-def _format_one(root: type[BaseModel], error: dict[str, Any]) -> list[tuple[str, str]]:
-    """(dotted key, message) pairs for one pydantic error."""
+def _format_one(root: Any, error: dict[str, Any]) -> list[tuple[tuple[str | int, ...], str]]:
+    """(key path, message) pairs for one pydantic error (``root``: the model or type validated)."""
     loc: tuple[str | int, ...] = tuple(error["loc"])
     kind = error["type"]
     value = error.get("input")
     ctx = error.get("ctx") or {}
 
     if kind == "value_error" and isinstance(ctx.get("error"), Problems):
-        return [(key_path(loc + rel), msg) for rel, msg in ctx["error"].problems]
+        return [(loc + rel, msg) for rel, msg in ctx["error"].problems]
     if kind in ("value_error", "assertion_error"):
         message = str(ctx.get("error", error["msg"]))
-        return [(key_path(loc), message)]
+        return [(loc, message)]
     if kind == "extra_forbidden":
         parent = _model_at(root, loc[:-1])
         allowed = _keys(parent) if parent is not None else []
         key = str(loc[-1])
         listed = f"expected one of: {', '.join(allowed)}" if allowed else "no keys expected here"
         if len(loc) == 1 and key in FUTURE_SECTIONS:
-            return [(key_path(loc),
+            return [(loc,
                      f"not supported yet (planned for a later version: {FUTURE_SECTIONS[key]}; {listed})")]
         hint = suggest(key, allowed)
         hint_text = f'; did you mean "{hint}"?' if hint else ""
-        return [(key_path(loc), f"unknown key{hint_text} ({listed})")]
+        return [(loc, f"unknown key{hint_text} ({listed})")]
     if kind == "missing":
-        return [(key_path(loc), "required key is missing")]
+        return [(loc, "required key is missing")]
     if kind in _TYPE_EXPECTED:
         expected = _TYPE_EXPECTED[kind]
         if kind in ("tuple_type", "list_type") and isinstance(value, dict):
-            return [(key_path(loc), f"expected an array of tables ([[{key_path(loc)}]]), got a single table")]
+            return [(loc, f"expected an array of tables ([[{key_path(loc)}]]), got a single table")]
         if kind in ("model_type", "dict_type") and isinstance(value, (list, tuple)):
-            return [(key_path(loc), f"expected a table ([{key_path(loc)}]), got {describe(value)}")]
-        return [(key_path(loc), f"expected {expected}, got {describe(value)}")]
+            return [(loc, f"expected a table ([{key_path(loc)}]), got {describe(value)}")]
+        return [(loc, f"expected {expected}, got {describe(value)}")]
     if kind in _BOUNDS:
         bound = next(iter(ctx.values()))
-        return [(key_path(loc), f"must be {_BOUNDS[kind]} {number_text(bound)} (got {show(value)})")]
+        return [(loc, f"must be {_BOUNDS[kind]} {number_text(bound)} (got {show(value)})")]
     if kind == "finite_number":
-        return [(key_path(loc), f"must be a finite number (got {show(value)})")]
+        return [(loc, f"must be a finite number (got {show(value)})")]
     if kind == "too_short":
-        return [(key_path(loc), f"expected at least {ctx.get('min_length')} item(s), got {ctx.get('actual_length')}")]
+        return [(loc, f"expected at least {ctx.get('min_length')} item(s), got {ctx.get('actual_length')}")]
     if kind == "too_long":
-        return [(key_path(loc), f"expected at most {ctx.get('max_length')} item(s), got {ctx.get('actual_length')}")]
+        return [(loc, f"expected at most {ctx.get('max_length')} item(s), got {ctx.get('actual_length')}")]
     if kind == "string_too_short":
-        return [(key_path(loc), f"must not be empty (got {show(value)})")]
+        return [(loc, f"must not be empty (got {show(value)})")]
     if kind == "string_pattern_mismatch":
-        return [(key_path(loc), f"may contain only letters, digits, '_', '.' and '-' (got {show(value)})")]
-    return [(key_path(loc), f"{error['msg']} (got {show(value)})")]
+        return [(loc, f"may contain only letters, digits, '_', '.' and '-' (got {show(value)})")]
+    return [(loc, f"{error['msg']} (got {show(value)})")]
 
 
 def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> ConfigError:
@@ -255,12 +255,18 @@ def config_error(source: str, root: type[BaseModel], exc: ValidationError) -> Co
     for error in errors:
         if error["type"] == "missing" and tuple(error["loc"]) in suggested:
             continue
-        for key, message in _format_one(root, dict(error)):
-            lines.append(f"{source}: {key}: {message}")
+        for loc, message in _format_one(root, dict(error)):
+            lines.append(f"{source}: {key_path(loc)}: {message}")
     if len(lines) > 1:
         more = len(lines) - 1
         lines.insert(1, f"({more} more problem{'s' if more > 1 else ''}:)")
     return ConfigError("\n".join(lines))
+
+
+def problems_of(root: Any, exc: ValidationError) -> list[tuple[tuple[str | int, ...], str]]:
+    """A pydantic error as (key path, message) problems (for :class:`Problems`): what :func:`config_error` says,
+    for a validator that validates part of its value itself (``root``: the model or type it validated)."""
+    return [problem for error in exc.errors(include_url=False) for problem in _format_one(root, dict(error))]
 
 
 _Model = TypeVar("_Model", bound=BaseModel)

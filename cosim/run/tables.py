@@ -9,19 +9,31 @@ documents every key.
 """
 from __future__ import annotations
 
+import functools
 import math
 import re
-from dataclasses import replace
+from collections.abc import Callable
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, Strict, model_validator
+from pydantic import (
+    ConfigDict,
+    Field,
+    PlainValidator,
+    SerializerFunctionWrapHandler,
+    Strict,
+    TypeAdapter,
+    ValidationError,
+    create_model,
+    model_serializer,
+    model_validator,
+)
 
 from cosim.analysis.fatigue import SNCurve, sn_curve, sn_curve_names
 from cosim.core.roughness import ISO_CLASSES
 from cosim.core.sensors import SECTION_POINT_QUANTITIES, SENSOR_QUANTITIES, Sensor
 from cosim.core.simulation import SolverSettings
 from cosim.core.traffic import ScriptedVehicle
-from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.vehicles import MODELS, ModelSpec, Parameter, VehicleModel
 from cosim.errors import ConfigError
 
 from .config_base import (
@@ -38,7 +50,9 @@ from .config_base import (
     describe,
     fail,
     number_problem,
+    problems_of,
     show,
+    suggest,
 )
 
 __all__ = [
@@ -57,11 +71,11 @@ __all__ = [
     "SensorConfig",
     "SolverConfig",
     "TrafficConfig",
-    "AxleConfig",
     "CONTACTS",
     "VEHICLE_MODELS",
-    "VEHICLE_PARAMETERS",
     "VehicleConfig",
+    "tyre_models",
+    "vehicle_parameters",
 ]
 
 # --------------------------------------------------------------------------- names
@@ -73,20 +87,11 @@ QUANTITIES: tuple[str, ...] = SENSOR_QUANTITIES
 SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
 
-#: Vehicle models of ``[[vehicles]]`` and their parameters: name -> (required, optional with default).
-VEHICLE_MODELS: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
-    "moving-force": (("mass",), {}),
-    "quarter-car": (("m_v", "m_w", "k_v", "c_v"), {}),
-    "tyre-quarter-car": (("m_v", "m_w", "k_v", "c_v", "k_t"), {"c_t": 0.0}),
-    "golden-car": (("m_v",), {}),
-    "half-car": (("m_b", "cg", "axles"), {"i_b": 0.0, "pitch": True}),
-}
-VEHICLE_PARAMETERS: tuple[str, ...] = ("mass", "m_v", "m_w", "k_v", "c_v", "k_t", "c_t", "m_b", "i_b", "cg", "axles",
-                                       "pitch")
+#: The vehicle models of ``[[vehicles]]`` (and of vTypes): the one registry, ``cosim.core.vehicles.MODELS``
+#: (``cosim.VEHICLE_MODELS``), name -> :class:`~cosim.core.vehicles.ModelSpec` with its parameters.
+VEHICLE_MODELS: dict[str, ModelSpec] = MODELS
 #: ``contact`` of ``[[vehicles]]``: the tyre holds to the deck, or may leave it (models with a tyre only).
 CONTACTS: tuple[str, ...] = ("bilateral", "unilateral")
-#: Models whose tyre may leave the deck.
-TYRE_MODELS: tuple[str, ...] = ("tyre-quarter-car", "golden-car", "half-car")
 DIRECTIONS: dict[str, int] = {"+x": 1, "-x": -1}
 
 #: ``[road].class``: an ISO 8608 class, or a smooth road.
@@ -217,38 +222,76 @@ def _rekeyed(exc: ConfigError, keys: tuple[str, ...]) -> Problems:
     return fail(str(exc))
 
 
-class AxleConfig(ConfigModel):
-    """``axles = [{...}, ...]`` of a half-car: one axle (both its wheels), positions behind the front axle."""
+def vehicle_parameters() -> dict[str, Parameter]:
+    """Every registered model's ``[[vehicles]]`` parameters by name, in registry order (a name two models share:
+    the first one's)."""
+    found: dict[str, Parameter] = {}
+    for spec in VEHICLE_MODELS.values():
+        for parameter in spec.parameters:
+            found.setdefault(parameter.name, parameter)
+    return found
 
-    distance: NonNegative
-    m_w: Positive
-    k_s: Positive
-    c_s: NonNegative
-    k_t: Positive
-    c_t: NonNegative = 0.0
 
-    def to_axle(self) -> Axle:
-        """The :class:`cosim.core.vehicles.Axle` this table describes."""
-        return Axle(distance=self.distance, m_w=self.m_w, k_s=self.k_s, c_s=self.c_s, k_t=self.k_t, c_t=self.c_t)
+def tyre_models() -> tuple[str, ...]:
+    """The models that take ``contact = "unilateral"`` (their tyre may leave the deck)."""
+    return tuple(name for name, spec in VEHICLE_MODELS.items() if spec.tyre)
+
+
+def _model_name(value: Any) -> str:
+    names = tuple(VEHICLE_MODELS)
+    if not isinstance(value, str) or value not in names:
+        raise fail(choices_message(value, names, "vehicle model"))
+    return value
+
+
+def _annotation(parameter: Parameter) -> Any:
+    """The pydantic type of a key of a table parameter (its bound checked: ``must be > 0 (got -1.0)``)."""
+    if parameter.kind == "flag":
+        return Annotated[bool, Strict()]
+    if parameter.kind == "tables":
+        return _tables(parameter)[0]
+    if parameter.above is not None:
+        return Annotated[float, Strict(), Field(gt=parameter.above)]
+    if parameter.at_least is not None:
+        return Annotated[float, Strict(), Field(ge=parameter.at_least)]
+    return Number
+
+
+@functools.cache
+def _tables(parameter: Parameter) -> tuple[Any, TypeAdapter]:
+    """The pydantic type of an array-of-tables parameter (each table a model of its ``fields``) and its adapter."""
+    fields: dict[str, Any] = {f.name: (_annotation(f), ... if f.required else f.default) for f in parameter.fields}
+    table = create_model(f"{parameter.name.capitalize()}Table", __base__=ConfigModel, **fields)
+    kind = tuple[table, ...]  # type: ignore[valid-type]
+    return kind, TypeAdapter(kind)
+
+
+def _checked(parameter: Parameter, value: Any) -> tuple[Any, list[tuple[tuple[str | int, ...], str]]]:
+    """A parameter's value as the model takes it (a float, a bool, a tuple of tables), or its problems."""
+    at = (parameter.name,)
+    if parameter.kind == "number":
+        problem = number_problem(value)
+        return (None, [(at, problem)]) if problem else (float(value), [])
+    if parameter.kind == "flag":
+        return (value, []) if isinstance(value, bool) else (None, [(at, f"expected a boolean, got {describe(value)}")])
+    kind, adapter = _tables(parameter)
+    try:
+        return adapter.validate_python(value), []
+    except ValidationError as exc:
+        return None, [(at + loc, message) for loc, message in problems_of(kind, exc)]
 
 
 class VehicleConfig(ConfigModel):
-    """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time."""
+    """``[[vehicles]]``: a scripted vehicle, its model and parameters, path, speed and entry time.
+
+    The model's parameters are those its registry entry lists (``cosim.core.vehicles.MODELS``): checked here
+    and kept as the table's other keys (``vehicle.m_v``; :attr:`parameters` with the defaults).
+    """
+
+    model_config = ConfigDict(extra="allow", frozen=True, allow_inf_nan=False)
 
     id: Name
-    model: Annotated[str, choice(tuple(VEHICLE_MODELS), "vehicle model")]
-    mass: Number | None = None
-    m_v: Number | None = None
-    m_w: Number | None = None
-    k_v: Number | None = None
-    c_v: Number | None = None
-    k_t: Number | None = None
-    c_t: Number | None = None
-    m_b: Number | None = None
-    i_b: Number | None = None
-    cg: Number | None = None
-    axles: tuple[AxleConfig, ...] | None = None
-    pitch: Annotated[bool, Strict()] | None = None
+    model: Annotated[str, PlainValidator(_model_name)]
     contact: Annotated[str, choice(CONTACTS, "contact")] = "bilateral"
     y: Number
     speed: Positive | None = None
@@ -256,42 +299,101 @@ class VehicleConfig(ConfigModel):
     direction: Annotated[str, choice(tuple(DIRECTIONS), "direction")] = "+x"
     profile: SpeedProfile | None = None
 
-    @model_validator(mode="after")
-    def _parameters(self) -> VehicleConfig:
-        required, optional = VEHICLE_MODELS[self.model]
+    @model_validator(mode="wrap")
+    @classmethod
+    def _parameters(cls, data: Any, handler: Callable[[Any], VehicleConfig]) -> VehicleConfig:
+        """The vehicle's own keys through pydantic, the model's parameters through the registry; the problems
+        of both in the order of the table's keys (its own, with the parameters after ``model``)."""
+        if not isinstance(data, dict):
+            return handler(data)
+        own = set(cls.model_fields)
+        known = vehicle_parameters()
+        order = ["id", "model", *known, *(k for k in cls.model_fields if k not in ("id", "model"))]
         problems: list[tuple[tuple[str | int, ...], str]] = []
-        listed = ", ".join((*required, *optional))
-        for key in VEHICLE_PARAMETERS:
-            if getattr(self, key) is not None and key not in required and key not in optional:
+        try:
+            vehicle: VehicleConfig | None = handler({k: v for k, v in data.items() if k in own})
+        except ValidationError as exc:
+            vehicle = None
+            problems += problems_of(cls, exc)
+        model = data.get("model")
+        spec = VEHICLE_MODELS.get(model) if isinstance(model, str) else None
+        values: dict[str, Any] = {}
+        unknown: list[tuple[tuple[str | int, ...], str]] = []
+        hinted = set()
+        for key, value in data.items():
+            if key in own or value is None:  # None: a key of another model in a scenario dumped by an older cosim
+                continue
+            parameter = spec.parameter(key) if spec is not None and key in spec.names else known.get(key)
+            if parameter is None:
+                hint = suggest(str(key), order)
+                hinted.add((hint,))
+                unknown.append(((key,), f"unknown key{f'; did you mean {show(hint)}?' if hint else ''} "
+                                        f"(expected one of: {', '.join(order)})"))
+                continue
+            checked, found = _checked(parameter, value)
+            problems += found
+            values[key] = checked
+        # A misspelt key also makes its correct spelling "missing": report the misspelling only.
+        problems = [p for p in problems if not (p[0] in hinted and p[1] == "required key is missing")]
+        problems.sort(key=lambda p: order.index(p[0][0]) if p[0] and p[0][0] in order else len(order))
+        if problems or unknown:
+            raise Problems(problems + unknown)
+        assert vehicle is not None and spec is not None
+        ordered = {key: values[key] for key in known if key in values}
+        object.__setattr__(vehicle, "__pydantic_extra__", ordered)
+        vehicle._check_parameters(spec)
+        return vehicle
+
+    @model_serializer(mode="wrap")
+    def _dump(self, handler: SerializerFunctionWrapHandler) -> dict[str, Any]:
+        """Every registered parameter after ``model`` (None where not given), as when they were fields."""
+        data = handler(self)
+        out = {"id": data.pop("id"), "model": data.pop("model")}
+        out.update({key: data.pop(key, None) for key in vehicle_parameters()})
+        out.update(data)
+        return out
+
+    def _check_parameters(self, spec: ModelSpec) -> None:
+        """The keys of the model, the speed, the contact and the model itself (the classes check the numbers)."""
+        given = self.__pydantic_extra__ or {}
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        listed = ", ".join(spec.names)
+        for key in given:
+            if key not in spec.names:
                 problems.append(((key,), f"not a parameter of model {show(self.model)} (its parameters: {listed})"))
-        for key in required:
-            if getattr(self, key) is None:
+        for key in spec.names:
+            if spec.parameter(key).required and key not in given:
                 problems.append(((key,), f"required key is missing (model {show(self.model)} needs {listed})"))
         if self.speed is not None and self.profile is not None:
             problems.append((("speed",), "give either speed or profile, not both"))
         if self.speed is None and self.profile is None:
             problems.append((("speed",), "required key is missing (give speed, m/s, or a speed profile)"))
-        if self.contact == "unilateral" and self.model not in TYRE_MODELS:
-            problems.append((("contact",), f"unilateral contact needs a tyre: use one of {', '.join(TYRE_MODELS)} "
+        if self.contact == "unilateral" and not spec.tyre:
+            problems.append((("contact",), f"unilateral contact needs a tyre: use one of {', '.join(tyre_models())} "
                                            f"(model {show(self.model)} keeps its wheel on the deck)"))
-        if self.axles is not None and not self.axles:
-            problems.append((("axles",), "expected at least one axle, got an empty array"))
+        for parameter in spec.parameters:
+            if parameter.kind == "tables" and parameter.name in given and not given[parameter.name]:
+                one = parameter.name[:-1] if parameter.name.endswith("s") else parameter.name
+                problems.append(((parameter.name,), f"expected at least one {one}, got an empty array"))
         if problems:
             raise Problems(problems)
         try:
             self.to_model()
         except ConfigError as exc:
-            raise _rekeyed(exc, VEHICLE_PARAMETERS) from None
-        return self
+            raise _rekeyed(exc, tuple(vehicle_parameters())) from None
+
+    @property
+    def spec(self) -> ModelSpec:
+        """The model's registry entry."""
+        return VEHICLE_MODELS[self.model]
 
     @property
     def parameters(self) -> dict[str, Any]:
-        """The model's parameters, defaults filled in (SI units; a half-car's axles as AxleConfig tables)."""
-        required, optional = VEHICLE_MODELS[self.model]
-        values = {key: getattr(self, key) for key in required}
-        values.update({key: getattr(self, key) if getattr(self, key) is not None else default
-                       for key, default in optional.items()})
-        return values
+        """The model's parameters, defaults filled in, required first (SI units; an array of tables as tables
+        with their keys as attributes: a half-car's ``axles[0].distance``)."""
+        given = self.__pydantic_extra__ or {}
+        spec = self.spec
+        return {key: given[key] if key in given else spec.parameter(key).default for key in spec.names}
 
     def to_model(self) -> VehicleModel:
         """The :mod:`cosim.core.vehicles` model this table describes.
@@ -299,20 +401,10 @@ class VehicleConfig(ConfigModel):
         Raises:
             ConfigError: a non-physical parameter (the vehicle classes check them).
         """
-        p = self.parameters
-        unilateral = self.contact == "unilateral"
-        if self.model == "moving-force":
-            return MovingForce(mass=p["mass"])
-        if self.model == "quarter-car":
-            return QuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"])
-        if self.model == "tyre-quarter-car":
-            return TyreQuarterCar(m_v=p["m_v"], m_w=p["m_w"], k_v=p["k_v"], c_v=p["c_v"], k_t=p["k_t"], c_t=p["c_t"],
-                                  unilateral=unilateral)
-        if self.model == "half-car":
-            return HalfCar(m_b=p["m_b"], i_b=p["i_b"], cg=p["cg"], axles=tuple(a.to_axle() for a in p["axles"]),
-                           pitch=p["pitch"], unilateral=unilateral)
-        golden = TyreQuarterCar.golden_car(p["m_v"])
-        return replace(golden, unilateral=unilateral) if unilateral else golden
+        spec = self.spec
+        values = {key: tuple(table.model_dump() for table in value) if spec.parameter(key).kind == "tables"
+                  else value for key, value in self.parameters.items()}
+        return spec.build(values, self.contact == "unilateral")
 
     def to_scripted(self) -> ScriptedVehicle:
         """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes."""

@@ -310,7 +310,8 @@ class SumoTraffic(LiveSumo):
                                     demand)
         super().__init__(settings, frame_sink)
         self.demand = settings.demand
-        self._axles: dict[str, tuple[tuple[float, float], ...]] = {}
+        self._axles: dict[str, tuple[tuple[float, float], ...]] = {}  # per contact: behind the bumper, left, m
+        self._sideways: set[str] = set()  # the types with a contact point beside the path (left != 0)
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
         self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
@@ -496,8 +497,14 @@ class SumoTraffic(LiveSumo):
         params = entry.params if entry is not None else {}
         typ = vehicle_type(type_id, vt.getVehicleClass(type_id), vt.getLength(type_id), mass, params)
         self.types[type_id] = typ
-        self._axles[type_id] = typ.axles
-        self._known({**dict(typ.axle_models()), **({type_id: typ.model} if len(typ.axles) > 1 else {})})
+        columns = typ.contact_columns()
+        self._axles[type_id] = tuple((back, left) for _, _, back, left in columns)
+        if any(left for _, left in self._axles[type_id]):
+            self._sideways.add(type_id)
+        models = {key: model for key, model, _, _ in columns}
+        if len(columns) > 1:
+            models[type_id] = typ.model
+        self._known(models)
 
     def _next_frame(self) -> Frame:
         return self.advance()
@@ -550,7 +557,7 @@ class SumoTraffic(LiveSumo):
                 self._seed_trail(vid, num[j])
         slots = trails.slots(ids)
         record_fronts(num, slots, trails.arrays, self.step)
-        vehicles = ids
+        vehicles, vtypes = ids, types
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(rows))
             back = 0.5 * num[:, 5]
@@ -568,6 +575,12 @@ class SumoTraffic(LiveSumo):
         beside = 0.0 if self.settings.edges else BESIDE_DECK
         x, y, v, a, keep = axles_on_path(num, slots, trails.arrays, back, owner, self._axis_frame, self.deck_y,
                                          self._x_range, (0.0, self.axis.length, beside))
+        if self._sideways and not self._sideways.isdisjoint(vtypes):  # wheels beside the path: across the axis
+            left = np.array([side for typ in vtypes for _, side in self._axles[typ]])
+            along = self._unit[0]
+            heading = np.radians(num[:, 2])
+            ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
+            y = y + ahead[owner] * left
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():

@@ -25,23 +25,25 @@ entries prefixed ``cosim.``: the suspension (``cosim.model``, ``cosim.m_w``,
   pitch inertia ``cosim.i_b`` or that of a uniform body as long as the vehicle
   (m_b L^2 / 12).
 
-A ``cosim.*`` param that is not one of these is an error that names the
-closest known one. Plain functions of values (the demand files' or
-libsumo's): no libsumo here.
+Each model's params, their defaults and its builder are its registry entry's
+(``cosim.core.vehicles.MODELS``, :class:`~cosim.core.vehicles.VTypeRecipe`):
+a registered model with a recipe is a ``cosim.model`` here. A ``cosim.*``
+param that is not one of these is an error that names the closest known one.
+Plain functions of values (the demand files' or libsumo's): no libsumo here.
 """
 from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 
-from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar, VehicleModel
+from cosim.core.vehicles import LIBRARY, MODELS, ModelSpec, TyreQuarterCar, VehicleModel, VTypeInputs
+from cosim.core.vehicles.registry import cell
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.library import LibraryVehicle, Suspension, entry_for
 
 __all__ = [
     "HEAVY_VCLASSES",
-    "PARAM_KEYS",
     "PARAM_PREFIX",
     "SOURCE_DEFAULT",
     "SOURCE_MASS",
@@ -49,18 +51,20 @@ __all__ = [
     "VehicleType",
     "axles_from_parameters",
     "check_parameter_names",
-    "half_car_model",
+    "markdown_table",
     "model_from_parameters",
+    "model_params",
+    "param_keys",
     "scaled_model",
     "vehicle_type",
+    "vtype_models",
 ]
 
 PARAM_PREFIX = "cosim."
-#: The vType params cosim reads (without the prefix).
-PARAM_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact", "pitch", "i_b")
-#: The params that describe the suspension itself (not the axles).
-SUSPENSION_KEYS = ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "contact", "pitch", "i_b")
-MODEL_KINDS = ("quarter-car", "tyre-quarter-car", "half-car", "moving-force")
+#: The params of the axles (every model reads them).
+AXLE_KEYS = ("axles", "axle_loads")
+#: ``cosim.model`` when a vType sets suspension params without it.
+DEFAULT_MODEL = "quarter-car"
 CONTACT_KINDS = ("bilateral", "unilateral")
 #: SUMO vehicle classes that count as trucks (a study's ``truck_share``).
 HEAVY_VCLASSES = ("bus", "coach", "truck", "trailer")
@@ -70,37 +74,73 @@ SOURCE_MASS = "SUMO mass"
 SOURCE_DEFAULT = "cosim default"
 
 
+def vtype_models() -> dict[str, ModelSpec]:
+    """The registered models a vType's ``cosim.model`` may name (those with a vType recipe), in registry order."""
+    return {name: spec for name, spec in MODELS.items() if spec.vtype is not None}
+
+
+def model_params(spec: ModelSpec) -> tuple[str, ...]:
+    """The ``cosim.*`` params (without the prefix) a model reads: ``model``, its suspension (library defaults),
+    the axles, ``contact`` (with a tyre) and its others."""
+    assert spec.vtype is not None
+    params = spec.vtype.parameters
+    return ("model", *(p.name for p in params if p.default is LIBRARY), *AXLE_KEYS,
+            *(("contact",) if spec.tyre else ()), *(p.name for p in params if p.default is not LIBRARY))
+
+
+def param_keys() -> tuple[str, ...]:
+    """Every ``cosim.*`` param cosim reads (without the prefix), in the order messages list them."""
+    specs = list(vtype_models().values())
+    params = [p for spec in specs if spec.vtype is not None for p in spec.vtype.parameters]
+    return ("model", *dict.fromkeys(p.name for p in params if p.default is LIBRARY), *AXLE_KEYS,
+            *(("contact",) if any(spec.tyre for spec in specs) else ()),
+            *dict.fromkeys(p.name for p in params if p.default is not LIBRARY))
+
+
+def markdown_table() -> str:
+    """The docs' table of each ``cosim.model`` and the params it reads (docs/own-network.md)."""
+    lines = [f"| `{PARAM_PREFIX}model` | the `{PARAM_PREFIX}*` params it reads besides `{PARAM_PREFIX}model`, "
+             f"`{PARAM_PREFIX}axles` and `{PARAM_PREFIX}axle_loads` | without `{PARAM_PREFIX}axles` |",
+             "|---|---|---|"]
+    for name, spec in vtype_models().items():
+        assert spec.vtype is not None
+        library = [p for p in spec.vtype.parameters if p.default is LIBRARY]
+        parts = []
+        if library:
+            parts.append(", ".join(f"`{PARAM_PREFIX}{p.name}` ({p.unit})" for p in library) +
+                         ": the library suspension of the vClass unless given")
+        if spec.tyre:
+            parts.append(f"`{PARAM_PREFIX}contact` (`bilateral` or `unilateral`)")
+        parts += [f"`{PARAM_PREFIX}{p.name}` ({p.unit or 'true or false'}: {p.doc})" for p in spec.vtype.parameters
+                  if p.default is not LIBRARY]
+        axles = "one body on the library's axles" if spec.vtype.one_body else "one axle at mid-length"
+        default = " (the default)" if name == DEFAULT_MODEL else ""
+        lines.append(f"| `{name}`{default} | {cell('; '.join(parts) or 'none')} | {axles} |")
+    return "\n".join(lines)
+
+
 def check_parameter_names(type_id: str, params: dict[str, str]) -> None:
     """Raise :class:`SumoError` for a ``cosim.*`` param cosim does not know, naming the closest known one."""
+    keys = param_keys()
     for key in params:
         if not key.startswith(PARAM_PREFIX):
             continue
         name = key[len(PARAM_PREFIX):]
-        if name in PARAM_KEYS:
+        if name in keys:
             continue
-        near = difflib.get_close_matches(name, PARAM_KEYS, n=1, cutoff=0.5)
+        near = difflib.get_close_matches(name, keys, n=1, cutoff=0.5)
         hint = f"did you mean `{PARAM_PREFIX}{near[0]}`? " if near else ""
         raise SumoError(f"vType {type_id}: unknown param `{key}` ({hint}cosim reads "
-                        f"{', '.join(PARAM_PREFIX + k for k in PARAM_KEYS)})")
-    model = params.get(PARAM_PREFIX + "model", "quarter-car")
-    allowed = MODEL_PARAMS.get(model)
-    if allowed is None:
+                        f"{', '.join(PARAM_PREFIX + k for k in keys)})")
+    model = params.get(PARAM_PREFIX + "model", DEFAULT_MODEL)
+    spec = vtype_models().get(model)
+    if spec is None:
         return  # an unknown model: the model's own check names it
+    allowed = model_params(spec)
     unused = [k for k in params if k.startswith(PARAM_PREFIX) and k[len(PARAM_PREFIX):] not in allowed]
     if unused:  # it would be ignored, silently
         raise SumoError(f"vType {type_id}: param `{unused[0]}` is not used by model {model} (its params: "
                         f"{', '.join(PARAM_PREFIX + k for k in allowed)})")
-
-
-#: The ``cosim.*`` params each vehicle model uses (any other is an error: it would be ignored).
-MODEL_PARAMS: dict[str, tuple[str, ...]] = {
-    "quarter-car": ("model", "m_w", "k_v", "c_v", "axles", "axle_loads"),
-    "tyre-quarter-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact"),
-    "half-car": ("model", "m_w", "k_v", "c_v", "k_t", "c_t", "axles", "axle_loads", "contact", "pitch", "i_b"),
-    "moving-force": ("model", "axles", "axle_loads"),
-}
-
-
 def _number(type_id: str, params: dict[str, str], key: str) -> float | None:
     text = params.get(PARAM_PREFIX + key)
     if text is None or text.strip() == "":
@@ -133,35 +173,6 @@ def _flag(type_id: str, params: dict[str, str], key: str, default: bool) -> bool
     return value in ("true", "1")
 
 
-def half_car_model(type_id: str, quarter: TyreQuarterCar, axles: tuple[tuple[float, float], ...], length: float,
-                   params: dict[str, str]) -> HalfCar:
-    """One body on the vType's axles: per axle its share of ``quarter`` (the whole vehicle's suspension).
-
-    Args:
-        quarter: the whole vehicle as one tyre quarter-car (masses kg, springs N/m, dampers N s/m).
-        axles: (distance behind the front bumper m, share of the load) per axle.
-        length: the vehicle's length, m (the default pitch inertia: a uniform body as long as the vehicle).
-        params: the vType's params (``cosim.pitch``, ``cosim.i_b``, ``cosim.contact``).
-
-    Raises:
-        SumoError: a param is not valid, or the body is not physical (a pitching body on one axle).
-    """
-    front = axles[0][0]
-    pitch = _flag(type_id, params, "pitch", len(axles) > 1)
-    i_b = _number(type_id, params, "i_b")
-    m_b = quarter.m_v
-    try:
-        return HalfCar(
-            m_b=m_b, i_b=m_b * length**2 / 12.0 if i_b is None else i_b,
-            cg=sum(share * (d - front) for d, share in axles),  # the axle loads' resultant: the shares hold
-            axles=tuple(Axle(distance=d - front, m_w=share * quarter.m_w, k_s=share * quarter.k_v,
-                             c_s=share * quarter.c_v, k_t=share * quarter.k_t, c_t=share * quarter.c_t)
-                        for d, share in axles),
-            pitch=pitch, unilateral=_contact(type_id, params))
-    except ConfigError as exc:
-        raise SumoError(f"vType {type_id}: {exc}") from None
-
-
 def _library_model(suspension: Suspension, mass: float) -> TyreQuarterCar:
     """The suspension set scaled to a vehicle of gross ``mass`` kg."""
     m_v = mass / (1.0 + suspension.m_w)
@@ -169,36 +180,44 @@ def _library_model(suspension: Suspension, mass: float) -> TyreQuarterCar:
                           k_t=suspension.k_t * m_v, c_t=suspension.c_t * m_v)
 
 
-def _param_model(type_id: str, mass: float, suspension: Suspension, params: dict[str, str]) -> VehicleModel:
-    """The model the ``cosim.*`` suspension params describe; a missing one from ``suspension`` at ``mass``."""
-    kind = params.get(PARAM_PREFIX + "model", "quarter-car").strip()
-    if kind not in MODEL_KINDS:
-        near = difflib.get_close_matches(kind, MODEL_KINDS, n=1)
+def _model_spec(type_id: str, params: dict[str, str]) -> ModelSpec:
+    """The registry entry ``cosim.model`` names (default quarter-car)."""
+    kind = params.get(PARAM_PREFIX + "model", DEFAULT_MODEL).strip()
+    models = vtype_models()
+    if kind not in models:
+        near = difflib.get_close_matches(kind, list(models), n=1)
         hint = f"; did you mean {near[0]}?" if near else ""
-        raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}model` must be {', '.join(MODEL_KINDS)} "
+        raise SumoError(f"vType {type_id}: param `{PARAM_PREFIX}model` must be {', '.join(models)} "
                         f"(got {kind!r}{hint})")
-    if kind == "moving-force":
-        return MovingForce(mass)
-    m_w = _number(type_id, params, "m_w")
-    m_w = suspension.unsprung_share() * mass if m_w is None else m_w
-    m_v = mass - m_w
-    if not m_v > 0:
-        raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}m_w` = {m_w:g} kg leaves no body mass (mass = {mass:g} kg)")
+    return models[kind]
 
-    def given(key: str, ratio: float) -> float:
-        value = _number(type_id, params, key)
-        return ratio * m_v if value is None else value
 
-    k_v, c_v = given("k_v", suspension.k_v), given("c_v", suspension.c_v)
-    unilateral = _contact(type_id, params)
-    try:
-        if kind == "quarter-car":
-            return QuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v)
-        # a half-car is first the whole vehicle on one tyre; vehicle_type shares it among the axles
-        return TyreQuarterCar(m_v=m_v, m_w=m_w, k_v=k_v, c_v=c_v, k_t=given("k_t", suspension.k_t),
-                              c_t=given("c_t", suspension.c_t), unilateral=unilateral)
-    except ConfigError as exc:
-        raise SumoError(f"vType {type_id}: {exc}") from None
+def _param_values(type_id: str, spec: ModelSpec, mass: float, suspension: Suspension,
+                  params: dict[str, str]) -> dict[str, float | bool | None]:
+    """The values of the params the model reads: given, else their default; a library one from ``suspension``
+    at ``mass`` (the unsprung mass as its share of the gross mass, the others per kg of body)."""
+    assert spec.vtype is not None
+    values: dict[str, float | bool | None] = {}
+    m_v = mass
+    if any(p.name == "m_w" and p.default is LIBRARY for p in spec.vtype.parameters):
+        m_w = _number(type_id, params, "m_w")
+        m_w = suspension.unsprung_share() * mass if m_w is None else m_w
+        m_v = mass - m_w
+        if not m_v > 0:
+            raise SumoError(f"vType {type_id}: `{PARAM_PREFIX}m_w` = {m_w:g} kg leaves no body mass "
+                            f"(mass = {mass:g} kg)")
+        values["m_w"] = m_w
+    for p in spec.vtype.parameters:
+        if p.name in values:
+            continue
+        if p.kind == "flag":
+            values[p.name] = _flag(type_id, params, p.name, p.default)
+            continue
+        value = _number(type_id, params, p.name)
+        if value is None:
+            value = getattr(suspension, p.name) * m_v if p.default is LIBRARY else p.default
+        values[p.name] = value
+    return values
 
 
 def axles_from_parameters(type_id: str, length: float, params: dict[str, str]) -> tuple[tuple[float, float], ...]:
@@ -233,11 +252,8 @@ def axles_from_parameters(type_id: str, length: float, params: dict[str, str]) -
 
 
 def scaled_model(model: VehicleModel, share: float) -> VehicleModel:
-    """The part of ``model`` carried by one axle: masses, stiffnesses and dampings times ``share``."""
-    if isinstance(model, MovingForce):
-        return MovingForce(model.mass * share)
-    scaled = {k: v * share for k, v in asdict(model).items() if isinstance(v, float | int) and not isinstance(v, bool)}
-    return replace(model, **scaled)  # type: ignore[arg-type]  # switches (unilateral contact) stay as they are
+    """The part of ``model`` carried by one axle (:meth:`~cosim.core.vehicles.VehicleModel.scaled`)."""
+    return model.scaled(share)
 
 
 @dataclass(frozen=True)
@@ -269,17 +285,28 @@ class VehicleType:
     def mass(self) -> float:
         return float(self.model.total_mass)
 
-    def axle_models(self) -> list[tuple[str, VehicleModel]]:
-        """(model table key, model) per axle: the type itself for one axle, ``type#k`` for axle k of several.
+    def contact_columns(self) -> list[tuple[str, VehicleModel, float, float]]:
+        """(model table key, model, distance behind the front bumper m, offset to the left of the path m) per
+        contact column: the type itself for one, ``type#k`` for column k of several.
 
-        Independent axles each get their share of the model; the axles of one body (a half-car) all
-        name the whole model, which the beam step recognises as one vehicle on several contacts.
+        Independent axles each get their share of the model (one column each); the contact points of one
+        body (a half-car's axles) all name the whole model, which the beam step recognises as one vehicle
+        on several contacts, placed from the first axle (a contact on one of the axles: at that axle).
         """
+        points = self.model.contact_points
+        if len(points) > 1:
+            front = self.axles[0][0]
+            on_axle = {d - front: d for d, _ in self.axles}
+            return [(f"{self.id}#{k}", self.model, on_axle.get(p.behind, front + p.behind), p.left)
+                    for k, p in enumerate(points)]
+        left = points[0].left
         if len(self.axles) == 1:
-            return [(self.id, self.model)]
-        if getattr(self.model, "contacts", 1) > 1:
-            return [(f"{self.id}#{k}", self.model) for k in range(len(self.axles))]
-        return [(f"{self.id}#{k}", scaled_model(self.model, share)) for k, (_, share) in enumerate(self.axles)]
+            return [(self.id, self.model, self.axles[0][0], left)]
+        return [(f"{self.id}#{k}", self.model.scaled(share), d, left) for k, (d, share) in enumerate(self.axles)]
+
+    def axle_models(self) -> list[tuple[str, VehicleModel]]:
+        """(model table key, model) per contact column (:meth:`contact_columns`)."""
+        return [(key, model) for key, model, _, _ in self.contact_columns()]
 
     def summary(self) -> dict:
         """A plain description (for logs and summaries)."""
@@ -325,26 +352,24 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
     gross = entry.mass if mass is None else float(mass)
     sources = {"mass": default if mass is None else SOURCE_MASS}
     details = {"mass": entry.mass_source if mass is None else "the vType's mass attribute"}
-    own = [k for k in SUSPENSION_KEYS if (PARAM_PREFIX + k) in params]
-    if own:
-        model = _param_model(type_id, gross, entry.suspension, params)
-        missing = [k for k in ("m_w", "k_v", "c_v") if k not in own]
-        if model.kind == "tyre-quarter-car":  # (a half-car too, until its axles are known)
-            missing += [k for k in ("k_t", "c_t") if k not in own]
-        if model.kind == "moving-force":
-            missing = []
+    own = [k for k in param_keys() if k not in AXLE_KEYS and (PARAM_PREFIX + k) in params]
+    spec = _model_spec(type_id, params) if own else None
+    if spec is not None and spec.vtype is not None:
+        values = _param_values(type_id, spec, gross, entry.suspension, params)
+        unilateral = _contact(type_id, params)
+        missing = [p.name for p in spec.vtype.parameters if p.default is LIBRARY and p.name not in own]
         sources["suspension"] = SOURCE_PARAMS + (f" + {SOURCE_DEFAULT}" if missing else "")
         details["suspension"] = ", ".join(PARAM_PREFIX + k for k in own) + (
             f"; {', '.join(missing)} from {entry.suspension.name} ({entry.suspension.source})" if missing else "")
     else:
-        model = _library_model(entry.suspension, gross)
+        model: VehicleModel = _library_model(entry.suspension, gross)
         sources["suspension"] = f"{SOURCE_DEFAULT}: {entry.suspension.name}"
         details["suspension"] = entry.suspension.source
     if (PARAM_PREFIX + "axles") in params or (PARAM_PREFIX + "axle_loads") in params:
         axles = axles_from_parameters(type_id, length if known else math.inf, params)
         sources["axles"] = SOURCE_PARAMS
         details["axles"] = f"{PARAM_PREFIX}axles, {PARAM_PREFIX}axle_loads"
-    elif own and params.get(PARAM_PREFIX + "model", "").strip() != "half-car":
+    elif spec is not None and spec.vtype is not None and not spec.vtype.one_body:
         axles = ((0.5 * length, 1.0),)
         sources["axles"] = SOURCE_PARAMS
         details["axles"] = f"one quarter-car at mid-length (no {PARAM_PREFIX}axles)"
@@ -352,9 +377,11 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
         axles, scaled = _library_axles(entry, length)
         sources["axles"] = default
         details["axles"] = entry.axles_source + (f"; scaled to the vType's {length:g} m" if scaled else "")
-    if own and params.get(PARAM_PREFIX + "model", "").strip() == "half-car":
-        assert isinstance(model, TyreQuarterCar)
-        model = half_car_model(type_id, model, axles, length, params)
+    if spec is not None and spec.vtype is not None:
+        try:
+            model = spec.vtype.build(VTypeInputs(type_id, gross, values, unilateral, axles, float(length)))
+        except ConfigError as exc:
+            raise SumoError(f"vType {type_id}: {exc}") from None
     return VehicleType(id=type_id, vclass=vclass, length=float(length), model=model, axles=axles,
                        sources=sources, details=details, library=entry.name, note=note)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 import cosim
-from cosim.sumo.vtypes import PARAM_KEYS
+from cosim.sumo.vtypes import param_keys
 
 REPO = Path(cosim.__file__).resolve().parents[1]
 PAGES = [REPO / "README.md", REPO / "benchmarks" / "README.md", *sorted((REPO / "docs").glob("*.md"))]
@@ -92,7 +92,7 @@ def _resolves(dotted: str) -> bool:
 
 
 #: ``cosim.<key>`` names that are not Python: SUMO vType params, and the misspelt one an error example shows.
-NOT_PYTHON = {f"cosim.{key}" for key in PARAM_KEYS} | {"cosim.kv"}
+NOT_PYTHON = {f"cosim.{key}" for key in param_keys()} | {"cosim.kv"}
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(REPO)) for p in PAGES])

@@ -15,6 +15,7 @@ source is its front axle; the others follow behind it.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -22,7 +23,9 @@ import numpy as np
 
 from cosim.errors import ConfigError
 
-from .base import LINEAR, check_non_negative, check_positive
+from .base import LINEAR, ContactPoint, VehicleModel, check_non_negative, check_positive
+from .registry import ModelSpec, Parameter, VTypeInputs, VTypeRecipe
+from .tyre_quarter_car import VTYPE_PARAMETERS, from_vtype
 
 #: Largest number of axles of one vehicle (bounds the compiled per-vehicle work).
 MAX_AXLES = 12
@@ -53,7 +56,7 @@ class Axle:
 
 
 @dataclass(frozen=True)
-class HalfCar:
+class HalfCar(VehicleModel):
     """A body with bounce (and pitch) on several axles, each with its own suspension, wheel and tyre.
 
     Args:
@@ -102,19 +105,9 @@ class HalfCar:
         return float(self.m_b + sum(a.m_w for a in self.axles))
 
     @property
-    def kernel_kind(self) -> int:
-        """Compiled kind: a linear vehicle."""
-        return LINEAR
-
-    @property
-    def contacts(self) -> int:
-        """Contact points (axles)."""
-        return len(self.axles)
-
-    @property
-    def contact_offsets(self) -> tuple[float, ...]:
-        """Each axle's distance behind the vehicle's contact point (its front axle), m."""
-        return tuple(a.distance for a in self.axles)
+    def contact_points(self) -> tuple[ContactPoint, ...]:
+        """One per axle, on the path: its distance behind the front axle, m."""
+        return tuple(ContactPoint(a.distance, 0.0) for a in self.axles)
 
     def pack(self) -> tuple[float, ...]:
         """Compiled parameters of a contact column: none beyond the per-axle ones of :meth:`linear_system`."""
@@ -176,11 +169,11 @@ class HalfCar:
             obs[k] = body
         k_t = np.array([a.k_t for a in self.axles])
         c_t = np.array([a.c_t for a in self.axles])
-        loads = static_axle_loads(mv, kv, b, k_t, gravity)
+        loads = linear_axle_loads(mv, kv, b, k_t, gravity)
         return {"mv": mv, "cv": cv, "kv": kv, "b": b, "k_t": k_t, "c_t": c_t, "loads": loads, "obs": obs}
 
 
-def static_axle_loads(mv: np.ndarray, kv: np.ndarray, b: np.ndarray, k_t: np.ndarray, gravity: float) -> np.ndarray:
+def linear_axle_loads(mv: np.ndarray, kv: np.ndarray, b: np.ndarray, k_t: np.ndarray, gravity: float) -> np.ndarray:
     """The tyre loads (N, compression positive) of a linear vehicle at rest on a rigid, level road.
 
     Gravity acts on every translational mass (the diagonal of ``mv`` on DOFs that
@@ -198,13 +191,66 @@ def _is_translation(mv: np.ndarray, b: np.ndarray, i: int) -> bool:
     return i == 0 or bool(np.any(b[:, i] != 0.0))
 
 
-def tyre_quarter_car_system(m_v: float, m_w: float, k_v: float, c_v: float, k_t: float, c_t: float,
-                            gravity: float) -> dict[str, np.ndarray]:
-    """The tyre quarter-car as a linear vehicle [body, wheel] (for unilateral contact)."""
-    mv = np.diag([m_v, m_w])
-    kv = k_v * np.array([[1.0, -1.0], [-1.0, 1.0]])
-    cv = c_v * np.array([[1.0, -1.0], [-1.0, 1.0]])
-    b = np.array([[0.0, 1.0]])
-    obs = np.array([[1.0, 0.0]])
-    return {"mv": mv, "cv": cv, "kv": kv, "b": b, "k_t": np.array([k_t]), "c_t": np.array([c_t]),
-            "loads": np.array([(m_v + m_w) * gravity]), "obs": obs}
+AXLE_FIELDS = (
+    Parameter("distance", "m", "behind the front axle: the first is `0`, then increasing", at_least=0.0),
+    Parameter("m_w", "kg", "the axle's wheels", above=0.0),
+    Parameter("k_s", "N/m", "the axle's suspension stiffness", above=0.0),
+    Parameter("c_s", "N s/m", "the axle's suspension damping", at_least=0.0),
+    Parameter("k_t", "N/m", "the axle's tyres", above=0.0),
+    Parameter("c_t", "N s/m", "the axle's tyre damping", 0.0, at_least=0.0),
+)
+
+
+def _from_table(values: Mapping[str, Any], unilateral: bool) -> HalfCar:
+    return HalfCar(m_b=values["m_b"], i_b=values["i_b"], cg=values["cg"],
+                   axles=tuple(Axle(**axle) for axle in values["axles"]), pitch=values["pitch"],
+                   unilateral=unilateral)
+
+
+def _from_vtype(vtype: VTypeInputs) -> HalfCar:
+    """One body on the vType's axles: per axle its share of the whole vehicle's suspension (docs/sumo.md).
+
+    The body's centre of gravity is where the axle loads put it (sum of share x distance, so a two-axle body
+    carries exactly the shares); its pitch inertia ``cosim.i_b`` or that of a uniform body as long as the
+    vehicle (m_b L^2 / 12); it pitches unless ``cosim.pitch = false`` or it has one axle.
+    """
+    quarter = from_vtype(vtype)  # the whole vehicle on one tyre, checked as such
+    axles = vtype.axles
+    front = axles[0][0]
+    pitch, i_b = vtype.values["pitch"], vtype.values["i_b"]
+    m_b = quarter.m_v
+    return HalfCar(
+        m_b=m_b, i_b=m_b * vtype.length**2 / 12.0 if i_b is None else i_b,
+        cg=sum(share * (d - front) for d, share in axles),  # the axle loads' resultant: the shares hold
+        axles=tuple(Axle(distance=d - front, m_w=share * quarter.m_w, k_s=share * quarter.k_v,
+                         c_s=share * quarter.c_v, k_t=share * quarter.k_t, c_t=share * quarter.c_t)
+                    for d, share in axles),
+        pitch=len(axles) > 1 if pitch is None else pitch, unilateral=vtype.unilateral)
+
+
+SPEC = ModelSpec(
+    name=HalfCar.kind, cls=HalfCar,
+    doc="a body of mass `m_b` and pitch inertia `i_b` about its centre of gravity, `cg` metres behind the front "
+        "axle, on any number of axles, each with its own suspension, wheel and tyre (docs/theory.md §11): the "
+        "pitch-plane model of two-axle cars and of trucks with tandem or tridem groups, whose axles share the "
+        "body's load through its springs. With `pitch = false` the body only bounces: the axles are tied into "
+        "one load-sharing group. One contact point per axle",
+    parameters=(
+        Parameter("m_b", "kg", "body (sprung) mass", above=0.0),
+        Parameter("i_b", "kg m^2", "body pitch inertia about its centre of gravity", 0.0, at_least=0.0,
+                  note="> 0 with pitch"),
+        Parameter("cg", "m", "centre of gravity behind the front axle", at_least=0.0),
+        Parameter("axles", "", "front axle first", kind="tables", fields=AXLE_FIELDS),
+        Parameter("pitch", "", "the body pitches (or only bounces)", True, kind="flag"),
+    ),
+    build=_from_table,
+    example=HalfCar(m_b=16000.0, i_b=6e4, cg=2.2, axles=(Axle(0.0, 700.0, 6e5, 3e4, 2.5e6, 2e3),
+                                                         Axle(4.0, 1100.0, 9e5, 5e4, 4e6, 3e3))),
+    tyre=True,
+    vtype=VTypeRecipe(
+        parameters=(*VTYPE_PARAMETERS,
+                    Parameter("pitch", "", "the body pitches (default: unless it has one axle)", None, kind="flag"),
+                    Parameter("i_b", "kg m^2", "body pitch inertia (default: a uniform body as long as the vehicle, "
+                              "m_b L^2 / 12)", None)),
+        build=_from_vtype, one_body=True),
+)

@@ -10,15 +10,17 @@ the moving-contact terms of a vehicle with speed ``v`` and acceleration ``a``::
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from ..jit import compiled
-from .base import QUARTER_CAR, OneContact, check_non_negative, check_positive
+from .base import QUARTER_CAR, VehicleModel, check_non_negative, check_positive
+from .registry import LIBRARY, ModelSpec, Parameter, VTypeInputs, VTypeRecipe
 
 
 @dataclass(frozen=True)
-class QuarterCar(OneContact):
+class QuarterCar(VehicleModel):
     """The paper's quarter-car with perfect wheel-deck contact.
 
     Args:
@@ -52,6 +54,36 @@ class QuarterCar(OneContact):
     def pack(self) -> tuple[float, ...]:
         """Compiled parameters: m_v, m_w, k_v, c_v."""
         return (self.m_v, self.m_w, self.k_v, self.c_v)
+
+
+#: Its ``[[vehicles]]`` keys (the tyre quarter-car shares them).
+M_V = Parameter("m_v", "kg", "body (sprung) mass", above=0.0)
+K_V = Parameter("k_v", "N/m", "suspension stiffness", above=0.0)
+C_V = Parameter("c_v", "N s/m", "suspension damping", at_least=0.0)
+#: Its vType params: the suspension of the vClass's library vehicle unless given (docs/sumo.md).
+VTYPE_M_W = Parameter("m_w", "kg", "unsprung (wheel and axle) mass", LIBRARY)
+VTYPE_K_V = Parameter("k_v", "N/m", "suspension stiffness", LIBRARY)
+VTYPE_C_V = Parameter("c_v", "N s/m", "suspension damping", LIBRARY)
+
+
+def _from_table(values: Mapping[str, Any], unilateral: bool) -> QuarterCar:
+    return QuarterCar(m_v=values["m_v"], m_w=values["m_w"], k_v=values["k_v"], c_v=values["c_v"])
+
+
+def _from_vtype(vtype: VTypeInputs) -> QuarterCar:
+    v = vtype.values
+    return QuarterCar(m_v=vtype.mass - v["m_w"], m_w=v["m_w"], k_v=v["k_v"], c_v=v["c_v"])
+
+
+SPEC = ModelSpec(
+    name=QuarterCar.kind, cls=QuarterCar,
+    doc="the paper's quarter-car: body `m_v` on a suspension `k_v`, `c_v` over a wheel `m_w` in perfect contact "
+        "with the deck; the road profile acts in the suspension",
+    parameters=(M_V, Parameter("m_w", "kg", "wheel (unsprung) mass; 0: the classical sprung mass", at_least=0.0),
+                K_V, C_V),
+    build=_from_table, example=QuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4),
+    vtype=VTypeRecipe(parameters=(VTYPE_M_W, VTYPE_K_V, VTYPE_C_V), build=_from_vtype),
+)
 
 
 @compiled

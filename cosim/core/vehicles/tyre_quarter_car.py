@@ -5,7 +5,8 @@ sets (body, wheel, suspension, tyre) apply directly.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -13,12 +14,13 @@ import numpy as np
 from cosim.errors import ConfigError
 
 from ..jit import compiled
-from .base import LINEAR, TYRE_QUARTER_CAR, OneContact, check_non_negative, check_positive
-from .half_car import tyre_quarter_car_system
+from .base import LINEAR, TYRE_QUARTER_CAR, VehicleModel, check_non_negative, check_positive
+from .quarter_car import C_V, K_V, M_V, VTYPE_C_V, VTYPE_K_V, VTYPE_M_W
+from .registry import LIBRARY, ModelSpec, Parameter, VTypeInputs, VTypeRecipe
 
 
 @dataclass(frozen=True)
-class TyreQuarterCar(OneContact):
+class TyreQuarterCar(VehicleModel):
     """Quarter-car with a tyre spring and damper (wheel as its own DOF).
 
     Args:
@@ -87,6 +89,50 @@ class TyreQuarterCar(OneContact):
         return cls(m_v=m_v, m_w=0.15 * m_v, k_v=63.3 * m_v, c_v=6.0 * m_v, k_t=653.0 * m_v, c_t=0.0)
 
 
+#: Its tyre keys (the half-car's axles share them).
+K_T = Parameter("k_t", "N/m", "tyre stiffness", above=0.0)
+C_T = Parameter("c_t", "N s/m", "tyre damping", 0.0, at_least=0.0)
+#: Its vType params beyond the quarter-car's.
+VTYPE_K_T = Parameter("k_t", "N/m", "tyre stiffness", LIBRARY)
+VTYPE_C_T = Parameter("c_t", "N s/m", "tyre damping", LIBRARY)
+
+
+def _from_table(values: Mapping[str, Any], unilateral: bool) -> TyreQuarterCar:
+    return TyreQuarterCar(m_v=values["m_v"], m_w=values["m_w"], k_v=values["k_v"], c_v=values["c_v"],
+                          k_t=values["k_t"], c_t=values["c_t"], unilateral=unilateral)
+
+
+def from_vtype(vtype: VTypeInputs) -> TyreQuarterCar:
+    """The whole vehicle of a vType on one tyre (the half-car shares it among its axles)."""
+    v = vtype.values
+    return TyreQuarterCar(m_v=vtype.mass - v["m_w"], m_w=v["m_w"], k_v=v["k_v"], c_v=v["c_v"], k_t=v["k_t"],
+                          c_t=v["c_t"], unilateral=vtype.unilateral)
+
+
+def _golden_car(values: Mapping[str, Any], unilateral: bool) -> TyreQuarterCar:
+    golden = TyreQuarterCar.golden_car(values["m_v"])
+    return replace(golden, unilateral=unilateral) if unilateral else golden
+
+
+#: Its vType params (the half-car reads them too).
+VTYPE_PARAMETERS = (VTYPE_M_W, VTYPE_K_V, VTYPE_C_V, VTYPE_K_T, VTYPE_C_T)
+
+SPEC = ModelSpec(
+    name=TyreQuarterCar.kind, cls=TyreQuarterCar,
+    doc="the wheel as its own DOF on a tyre spring `k_t` and damper `c_t`; the road profile acts in the tyre",
+    parameters=(M_V, Parameter("m_w", "kg", "wheel (unsprung) mass", above=0.0), K_V, C_V, K_T, C_T),
+    build=_from_table, example=TyreQuarterCar(m_v=8000.0, m_w=1000.0, k_v=4e5, c_v=4e4, k_t=3e6, c_t=1e4),
+    tyre=True, vtype=VTypeRecipe(parameters=VTYPE_PARAMETERS, build=from_vtype),
+)
+#: A preset: the IRI reference car scaled to its body mass.
+GOLDEN_CAR = ModelSpec(
+    name="golden-car", cls=TyreQuarterCar,
+    doc="a `tyre-quarter-car` with the IRI reference (\"golden car\") ratios scaled to the body mass: "
+        "`k_v = 63.3 m_v`, `c_v = 6.0 m_v`, `k_t = 653 m_v`, `m_w = 0.15 m_v`, `c_t = 0`",
+    parameters=(M_V,), build=_golden_car, example=TyreQuarterCar.golden_car(300.0), tyre=True,
+)
+
+
 @compiled
 def coefficients(i, p, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha, e0, c0, c1, c2, aux):  # noqa: ANN001, ANN201
     """Deck-force coefficients of vehicle ``i`` (docs/theory.md (6.11)-(6.13)).
@@ -127,3 +173,15 @@ def update(i, p, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha):  # noqa: 
     susp = S0 + mv * (acc_b - acc_w)
     tyre = T0 + mt * acc_w - ta
     return acc_b, acc_w, susp, tyre, tyre, tyre
+
+
+def tyre_quarter_car_system(m_v: float, m_w: float, k_v: float, c_v: float, k_t: float, c_t: float,
+                            gravity: float) -> dict[str, np.ndarray]:
+    """The tyre quarter-car as a linear vehicle [body, wheel] (for unilateral contact)."""
+    mv = np.diag([m_v, m_w])
+    kv = k_v * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    cv = c_v * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    b = np.array([[0.0, 1.0]])
+    obs = np.array([[1.0, 0.0]])
+    return {"mv": mv, "cv": cv, "kv": kv, "b": b, "k_t": np.array([k_t]), "c_t": np.array([c_t]),
+            "loads": np.array([(m_v + m_w) * gravity]), "obs": obs}
