@@ -1,15 +1,16 @@
-"""A log's topics as CSV (``cosim export``, ``cosim run --csv``): SI units, every float in its shortest exact form."""
+"""A log's topics as CSV (``cosim export``, ``cosim run --csv``): SI units, every float in its shortest exact form.
+
+Importing this module loads neither mcap nor numpy (the command line's help lists :data:`EXPORT_TOPICS`).
+"""
 from __future__ import annotations
 
 import csv
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from cosim.core.fields import VEHICLE_FIELDS
 from cosim.errors import CosimError
-from cosim.log.reader import check_window, iter_messages, open_log
-from cosim.log.records import ReadStats
 from cosim.log.schemas import (
     EVENTS_SCHEMA,
     STATUS_SCHEMA,
@@ -20,6 +21,9 @@ from cosim.log.schemas import (
 )
 
 from .outputs import atomic_write, check_new_file, check_not_input
+
+if TYPE_CHECKING:  # the reader loads mcap and numpy: only when a log is read
+    from cosim.log.records import ReadStats
 
 #: The topics a log can be exported from.
 EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS)
@@ -55,6 +59,8 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
         LogError: the log cannot be read. CosimError: not an exportable topic, a window that is empty or
             outside the log, or the CSV cannot be written.
     """
+    from cosim.log.reader import check_window, iter_messages, open_log
+
     log, out = Path(log), Path(out)
     check_window(start, end)  # before the log is read
     overview = open_log(log, check="summary", stats=stats)
