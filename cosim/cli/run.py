@@ -1,30 +1,24 @@
 """``cosim run`` and ``cosim replay``: a run (or a replay) into an MCAP log with its summary, or a static case.
 
-The work is :mod:`cosim.run` (:func:`cosim.run.logged.run_logged`,
-:func:`cosim.run.replay.replay_scenario`, :func:`cosim.run.static.static_cases`);
-this module checks the outputs first, shows the progress and prints.
+Each command is one call of :mod:`cosim.run` (:func:`cosim.run.api.run_scenario`,
+:func:`cosim.run.replay.replay_log`), which checks, builds, runs and writes;
+this module shows the run's header and progress through the call's callbacks,
+and prints what it returns.
 """
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
-from cosim.core.bridge import BridgeModel
 from cosim.core.traffic import vehicle_of
-from cosim.errors import CosimError
-from cosim.run.export import export_csv
-from cosim.run.inputs import scenario_files
-from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome, run_logged
-from cosim.run.outputs import atomic_write, check_new_file, check_not_input, check_writable, unique_path
-from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
-from cosim.run.replay import Comparison, compare_sensors, replay_scenario
-from cosim.run.scenario import Scenario, load_scenario
-from cosim.run.simulate import SumoPlan, plan_sumo
-from cosim.run.static import STATIC_LOAD_N, static_cases
+from cosim.run.api import NO_VEHICLES, RunStart, StaticRun, run_scenario
+from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome
+from cosim.run.replay import Comparison, ReplayPlan, replay_log
+from cosim.run.scenario import Scenario
+from cosim.run.simulate import SumoPlan
+from cosim.run.static import STATIC_LOAD_N
 from cosim.run.units import display_unit
 
 from .text import (
@@ -40,63 +34,40 @@ from .text import (
 
 #: The scenario of ``cosim run`` without one.
 DEFAULT_SCENARIO = "paper-bridge-traffic"
-NO_VEHICLES = (
-    "the scenario has no [[vehicles]]; "
-    "this run does the modal analysis and a static load case"
-)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     """With vehicles or traffic: the logged time simulation and its summary; without: modes and a static case."""
-    if args.out is not None and Path(args.out).suffix.lower() == ".csv":
-        raise CosimError(
-            f"{args.out}: --out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv {args.out}"
-        )
-    scenario = load_scenario(args.scenario)
-    if scenario.vehicles or scenario.traffic is not None:
-        return _run_vehicles(scenario, args)
-    return _run_static(scenario, args)
+    display = RunDisplay(quiet=args.quiet)
 
+    def checked(scenario: Scenario) -> None:
+        print(scenario_line(scenario))
+        if not scenario.vehicles and scenario.traffic is None:
+            print(f"note: {NO_VEHICLES}")
 
-def _run_static(scenario: Scenario, args: argparse.Namespace) -> int:
-    """Without vehicles: the modes and a static load case; ``--out`` writes them as JSON (no log)."""
-    if args.out is not None and Path(args.out).suffix.lower() == ".mcap":
-        raise CosimError(
-            f"{args.out}: the scenario has no [[vehicles]], so there is no time simulation to log; "
-            "--out writes the modes and static displacements as JSON (e.g. --out summary.json)"
-        )
-    if args.csv is not None:
-        raise CosimError(f"{args.csv}: the scenario has no [[vehicles]]: no sensor time histories for --csv")
-    if args.out is not None:
-        check_not_input(args.out, "summary", scenario_files(scenario))
-        check_writable(args.out, "summary", force=args.force)
-    print(scenario_line(scenario))
-    print(f"note: {NO_VEHICLES}")
-    bridge = scenario.build_bridge()
-    modal = bridge.modes(count=10)
-    cases = static_cases(scenario, bridge)
-    print_lines(["", *damping_lines(bridge), ""])
-    print_lines(modes_lines(modal))
-    print()
-    print_lines(_static_lines(scenario, cases))
-    if args.out is not None:
-        summary = {
-            "scenario": scenario.title,
-            "source": scenario.source,
-            "note": NO_VEHICLES,
-            "section": section_payload(bridge.section),
-            "damping": damping_payload(bridge),
-            "modes": modes_payload(modal),
-            "static": cases,
-            "units": {"x": "m", "y": "m", "Fz": "N", "w": "m (positive up)", "f_hz": "Hz"},
-        }
-        with atomic_write(args.out, "summary") as partial:
-            partial.write_text(json.dumps(jsonable(summary), indent=2) + "\n", encoding="utf-8")
-        print(f"\nWrote the summary to {args.out}")
+    try:
+        done = run_scenario(args.scenario, out=args.out, csv=args.csv, force=args.force, checked=checked,
+                            ready=display.ready, progress=display)
+    except (RunFailed, RunInterrupted) as exc:
+        return display.stopped(exc)
+    finally:
+        display.close()
+    if isinstance(done, StaticRun):
+        print_lines(["", *damping_lines(done.bridge), ""])
+        print_lines(modes_lines(done.modal))
+        print()
+        print_lines(_static_lines(done.scenario, done.cases))
+        if args.out is not None:
+            print(f"\nWrote the summary to {args.out}")
+        return 0
+    print_outcome(done.outcome)
+    if done.csv_path is not None:
+        print(f"Wrote {done.csv_rows} rows to {done.csv_path} (columns {','.join(done.csv_columns)}; "
+              "SI units: m, m/s, m/s^2, N m)")
     return 0
 
 
-def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
+def _static_lines(scenario: Scenario, cases: tuple[dict[str, Any], ...]) -> list[str]:
     load = cases[0]["load"]
     heads = [f"load at y = {c['load']['y']:g} m" for c in cases]
     lines = [
@@ -163,18 +134,6 @@ class Progress:
         elif self._tenths is not None:
             print(file=self._stream, flush=True)
             self._tenths = None
-
-
-def _log_target(out: str | None, default: Path, force: bool) -> Path:
-    """The log to write: ``out`` (must end in .mcap) or ``default``; checked before any work."""
-    if out is not None:
-        path = Path(out)
-        if path.suffix.lower() != ".mcap":
-            raise CosimError(f"{out}: the log is an MCAP file: give a path ending in .mcap")
-    else:
-        path = default
-    check_new_file(path, "log", force)
-    return path
 
 
 _PARAMETER_UNITS = {"mass": "kg", "m_v": "kg", "m_w": "kg", "k_v": "N/m", "c_v": "N s/m", "k_t": "N/m", "c_t": "N s/m",
@@ -389,121 +348,100 @@ def _log_done_line(outcome: RunOutcome) -> str:
             f"at {fmt_g(outcome.rate_hz, 4)} Hz from t = 0; status finished)")
 
 
-def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path, duration: float | None = None,
-                  plan: SumoPlan | None = None) -> list[str]:
+def header_lines(start: RunStart) -> list[str]:
+    """What a logged run prints before its time stepping: bridge, damping, traffic, road, solver, log."""
+    scenario, bridge = start.scenario, start.bridge
     spans = " + ".join(f"{span:g}" for span in bridge.spans)
-    replayed = not scenario.vehicles and scenario.traffic is None
     return [
         f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
         *damping_lines(bridge),
-        *(["Traffic: the replayed log's SUMO frames"] if replayed else _vehicle_lines(scenario, plan)),
+        *(["Traffic: the replayed log's SUMO frames"] if start.replayed_frames
+          else _vehicle_lines(scenario, start.plan)),
         _road_line(scenario),
-        _solver_line(scenario, duration if duration is not None else scenario.duration),
-        _logging_line(scenario, log_path),
+        _solver_line(scenario, start.duration),
+        _logging_line(scenario, start.log_path),
     ]
 
 
-def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, args: argparse.Namespace,
-                     **extra: Any) -> tuple[int, RunOutcome | None]:
-    """The time simulation into ``log_path``: (exit status, outcome) with the failure messages printed."""
-    duration = extra.get("duration") or scenario.duration
-    sys.stdout.flush()
-    progress = Progress(duration, show=not args.quiet)
-    try:
-        outcome = run_logged(scenario, log_path, force=args.force, bridge=bridge, progress=progress, **extra)
-    except RunFailed as exc:
-        progress.close()
-        report_error(f"{exc} (the run failed; its log {exc.log_path} is finished, status \"error\")")
-        return EXIT_RUN_FAILED, None
-    except RunInterrupted as exc:
-        progress.close()
+class RunDisplay:
+    """What ``cosim run`` and ``cosim replay`` show while a logged run goes: its header on stdout once the
+    bridge is built (:meth:`ready`), then its progress on stderr (a progress callback); and the one line
+    a failed or stopped run ends with (:meth:`stopped`)."""
+
+    def __init__(self, quiet: bool) -> None:
+        self.quiet = quiet
+        self.duration = 0.0
+        self.progress: Progress | None = None
+
+    def ready(self, start: RunStart) -> None:
+        print_lines(header_lines(start))
+        sys.stdout.flush()
+        self.duration = start.duration
+        self.progress = Progress(start.duration, show=not self.quiet)
+
+    def __call__(self, fraction: float) -> None:
+        if self.progress is not None:
+            self.progress(fraction)
+
+    def close(self) -> None:
+        if self.progress is not None:
+            self.progress.close()
+
+    def stopped(self, exc: RunFailed | RunInterrupted) -> int:
+        """Report a run that failed or was stopped after it was set up (one line on stderr); its exit status."""
+        self.close()
+        if isinstance(exc, RunFailed):
+            report_error(f"{exc} (the run failed; its log {exc.log_path} is finished, status \"error\")")
+            return EXIT_RUN_FAILED
+        fraction = self.progress.fraction if self.progress is not None else 0.0
         where = (f"the log up to there is in {exc.log_path} (finished, status \"interrupted\")"
                  if exc.log_path is not None else "the run had not started: no log was written")
         try:
-            print(f"cosim: interrupted by {exc.name} at about t = {progress.fraction * duration:.4g} s of "
-                  f"{duration:g} s; {where}", file=sys.stderr)
+            print(f"cosim: interrupted by {exc.name} at about t = {fraction * self.duration:.4g} s of "
+                  f"{self.duration:g} s; {where}", file=sys.stderr)
         except (OSError, ValueError):  # SIGHUP: the terminal may be gone
             pass
-        return 128 + exc.signum, None
-    finally:
-        progress.close()
-    return 0, outcome
+        return 128 + exc.signum
 
 
-def _print_outcome(scenario: Scenario, outcome: RunOutcome) -> None:
+def print_outcome(outcome: RunOutcome) -> None:
     """The end-of-run summary: sensor peaks, vehicles, counters, the log written."""
     print()
-    print_lines(_sensor_summary(scenario, outcome.result))
+    print_lines(_sensor_summary(outcome.scenario, outcome.result))
     print_lines(_fatigue_summary(outcome))
     print_lines(_vehicle_summary(outcome))
     print_lines(_run_lines(outcome))
     print(_log_done_line(outcome))
 
 
-def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
-    """With [[vehicles]]: the time simulation into an MCAP log, an optional sensor CSV and a summary."""
-    default = scenario.log_path or unique_path(scenario.default_log_path())
-    log_path = _log_target(args.out, default, args.force)
-    csv_path = Path(args.csv) if args.csv is not None else scenario.csv_path
-    inputs = scenario_files(scenario)
-    check_not_input(log_path, "log", inputs)
-    if csv_path is not None:
-        check_not_input(csv_path, "sensor CSV", [*inputs, ("the run's log (--out)", log_path)])
-        check_new_file(csv_path, "sensor CSV", args.force)
-    # SUMO: the network and demand are read (and a wrong edge or vType reported) before anything is written.
-    plan = plan_sumo(scenario) if scenario.traffic is not None else None
-    print(scenario_line(scenario))
-    bridge = scenario.build_bridge()
-    print_lines(_header_lines(scenario, bridge, log_path, plan=plan))
-    status, outcome = _simulate_logged(scenario, bridge, log_path, args)
-    if outcome is None:
-        return status
-    _print_outcome(scenario, outcome)
-    if csv_path is not None:
-        rows, columns = export_csv(log_path, csv_path, force=args.force)
-        print(f"Wrote {rows} rows to {csv_path} (columns {','.join(columns)}; SI units: m, m/s, m/s^2, N m)")
-    return 0
-
-
 def cmd_replay(args: argparse.Namespace) -> int:
     """Re-drive the log's bridge (or ``--scenario``'s) with its traffic, logged; compare the sensors."""
-    other = load_scenario(args.scenario) if args.scenario is not None else None
     log = Path(args.log)
-    with tempfile.TemporaryDirectory(prefix="cosim-replay-") as scratch:
-        plan = replay_scenario(log, Path(scratch), other)
+    display = RunDisplay(quiet=args.quiet)
+
+    def checked(plan: ReplayPlan) -> None:
         scenario = plan.scenario
-        default = unique_path(scenario.default_log_path(suffix="-replay"))
-        log_path = _log_target(args.out, default, args.force)
-        check_not_input(log_path, "replay's log", [("the log it replays", log),
-                                                   *(scenario_files(other) if other is not None else [])])
-        status_word = plan.overview.status_word
         if plan.traffic is not None:
             what = f"its SUMO traffic ({plan.record.get('traffic', 'logged frames')}; SUMO is not run again)"
         else:
             ids = ", ".join(v.id for v in scenario.vehicles)
             what = f"its {len(scenario.vehicles)} scripted vehicle(s) {ids}"
-        print(f"Replay of {log} ({plan.record['log_scenario']}, {status_word}): {what}")
-        if plan.own:
-            print(f"Bridge, sensors, road and solver: the log's own scenario ({scenario.title})")
-        else:
-            print(f"Bridge, sensors, road and solver: {other.source if other else ''} ({scenario.title})")
-        bridge = scenario.build_bridge()
-        print_lines(_header_lines(scenario, bridge, log_path, plan.duration))
-        try:
-            status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
-                                               attachments=plan.attachments, traffic=plan.traffic,
-                                               duration=plan.duration)
-        finally:
-            if plan.traffic is not None:
-                plan.traffic.close()
-    if outcome is None:
-        return status
-    _print_outcome(scenario, outcome)
-    comparison = compare_sensors(log, log_path)
+        print(f"Replay of {log} ({plan.record['log_scenario']}, {plan.overview.status_word}): {what}")
+        bridge_from = "the log's own scenario" if plan.own else plan.record["scenario"]
+        print(f"Bridge, sensors, road and solver: {bridge_from} ({scenario.title})")
+
+    try:
+        done = replay_log(log, args.scenario, out=args.out, force=args.force, checked=checked,
+                          ready=display.ready, progress=display)
+    except (RunFailed, RunInterrupted) as exc:
+        return display.stopped(exc)
+    finally:
+        display.close()
+    print_outcome(done.outcome)
     print()
-    if plan.own:
-        return _print_reproduction(comparison, log)
-    print_lines(_comparison_lines(comparison, log, log_path, scenario))
+    if done.own:
+        return _print_reproduction(done.comparison, log)
+    print_lines(_comparison_lines(done.comparison, log, done.outcome.log_path, done.start.scenario))
     return 0
 
 
