@@ -240,7 +240,6 @@ PENDING_PRIVATE_READS = {
     ("cosim/core/coupling.py", "_deck_coefficients"),  # BridgeModel's, read by CoupledSystem
     ("cosim/core/jit.py", "_locator_classes"),  # numba's cache locators, extended with cosim's
     ("cosim/core/jit.py", "_CacheImpl"),  # imported from numba.core.caching
-    ("cosim/cli/app.py", "_negative_number_matcher"),  # argparse's, so that "--from -5" is a value
 }
 
 

@@ -1,47 +1,52 @@
-"""``cosim export``, ``cosim info`` and ``cosim plot``: what is in a log, as CSV, text or a figure."""
+"""``cosim info``: what a log holds, and whether it is whole."""
 from __future__ import annotations
 
 import argparse
 import json
-import sys
+import textwrap
+from typing import TYPE_CHECKING
 
-from cosim.core.traffic import vehicle_of
-from cosim.log.reader import LogOverview, file_is_complete, iter_messages, open_log
-from cosim.log.records import ReadStats
-from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
-from cosim.run.export import export_csv
-from cosim.run.figures import plot_log_sensors
-from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
+from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_TRAFFIC
 
+from .options import FORMATTER, Subcommands
 from .text import fmt_g, print_lines, size_text
 
+if TYPE_CHECKING:
+    from cosim.log.reader import LogOverview
 
-def window_text(start: float | None, end: float | None) -> str:
-    """`` from t = T0 to T1 s`` for a window of time given on the command line ("" for none)."""
-    if start is None and end is None:
-        return ""
-    low = f"t = {fmt_g(start, 9)}" if start is not None else "the start"
-    high = f"{fmt_g(end, 9)} s" if end is not None else "the end"
-    if start is None:
-        high = f"t = {high}"
-    return f" from {low} to {high}"
+NAME = "info"
 
 
-def cmd_export(args: argparse.Namespace) -> int:
-    """Write a topic of a log (or of a window of it) as CSV."""
-    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force, start=args.start,
-                               end=args.end)
-    if not file_is_complete(args.log):
-        print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
-              file=sys.stderr)
-    units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
-    print(f"Wrote {rows} rows of {args.topic}{window_text(args.start, args.end)} to {args.csv} "
-          f"(columns {','.join(columns)}; {units})")
-    return 0
+def add_parser(commands: Subcommands) -> None:
+    """``cosim info``: its arguments and help."""
+    info = commands.add_parser(
+        "info",
+        help="summarise a log: scenario, duration, topics, status, truncated or not",
+        description=textwrap.dedent(
+            """\
+            Summarise a log: its scenario, cosim version, simulated time, sensors, topics
+            with message counts, final status and message, whether the file is truncated
+            (cut short by a killed process: exit status 0, the readable part is shown) and
+            its attachments. A finished log is read through its summary (counts, times,
+            chunk index) in seconds however long it is; every byte is checked against the
+            file's checksums, and the chunk holding the final status is decompressed.
+            --verify also decompresses every chunk, verifies its checksum and counts the
+            messages (the summary must agree). A damaged file or one that is not a cosim
+            MCAP log exits with status 2."""
+        ),
+        epilog="examples:\n  cosim info runs/run1.mcap\n  cosim info --verify runs/run1.mcap\n",
+        formatter_class=FORMATTER,
+    )
+    info.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    info.add_argument("--verify", action="store_true",
+                      help="decompress every chunk and verify every checksum (seconds per 100 MB of log)")
+    info.set_defaults(func=cmd_info)
 
 
 def cmd_info(args: argparse.Namespace) -> int:
     """Summarise a log: from its summary, or (``--verify``) from every chunk."""
+    from cosim.log.reader import open_log
+
     print_lines(info_lines(open_log(args.log, check="full" if args.verify else "file")))
     return 0
 
@@ -133,6 +138,11 @@ def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
     Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
     thousands): the vehicles of a long log are those of its start, and the line says so.
     """
+    from cosim.core.traffic import vehicle_of
+    from cosim.log.reader import iter_messages
+    from cosim.log.records import ReadStats
+    from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
+
     axles: dict[str, int] = {}
     stats = ReadStats()
     budget = None if o.check == "full" else EVENT_CHUNKS
@@ -165,11 +175,3 @@ def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
     return lines, stats.chunks
-
-
-def cmd_plot(args: argparse.Namespace) -> int:
-    """Draw a log's sensor time histories (or a window of them)."""
-    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force, start=args.start, end=args.end)
-    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)})"
-          f"{window_text(args.start, args.end)} to {args.output}")
-    return 0
