@@ -30,8 +30,6 @@ NAME = "bridge"
 DASH_VALUES = {"--edge": DashValue(numbers=False)}
 #: Candidates listed without --count.
 DEFAULT_COUNT = 15
-#: The plot shows the network this far beyond the deck's ends, m.
-PLOT_MARGIN = 60.0
 
 
 def add_parser(commands: Subcommands) -> None:
@@ -76,6 +74,7 @@ def add_parser(commands: Subcommands) -> None:
 
 def cmd_bridge(args: argparse.Namespace) -> int:
     """List candidate bridges, or describe one and print its scenario lines."""
+    from cosim.run.figures import plot_bridge_location
     from cosim.run.outputs import check_new_file
     from cosim.sumo.network import locate_bridge, net_path
 
@@ -93,7 +92,7 @@ def cmd_bridge(args: argparse.Namespace) -> int:
     location = locate_bridge(net, args.edge)
     print_lines(_location_lines(location, source, args))
     if args.plot is not None:
-        _plot(location, Path(args.plot))
+        plot_bridge_location(location, Path(args.plot))
         print(f"\nWrote the network around the bridge to {args.plot}")
     return 0
 
@@ -179,27 +178,3 @@ def _location_lines(loc: BridgeLocation, source: Path, args: argparse.Namespace)
     ]
     return lines
 
-
-def _plot(loc: BridgeLocation, path: Path) -> None:
-    import numpy as np
-
-    from cosim.plots import network_figure
-    from cosim.sumo.network import lane_shapes
-
-    axis = loc.axis
-    middle = tuple(0.5 * (np.asarray(axis.start) + np.asarray(axis.end)))
-    half = 0.5 * axis.length + PLOT_MARGIN
-    shapes = lane_shapes(loc.net, (float(middle[0]), float(middle[1])), half)
-    deck_ids = set(loc.deck_lanes)
-    e, n = axis.unit()
-    lo, hi = loc.carriageway
-    s = np.asarray(axis.start, dtype=float)
-    corners = [s + lo * n, s + axis.length * e + lo * n, s + axis.length * e + hi * n, s + hi * n, s + lo * n]
-    network_figure(
-        lanes=[pts for lid, pts in shapes if lid not in deck_ids and not lid.startswith(":")],
-        junction_lanes=[pts for lid, pts in shapes if lid.startswith(":")],
-        deck_lanes=[pts for lid, pts in shapes if lid in deck_ids],
-        outline=np.array(corners), axis=np.array([axis.start, axis.end]),
-        title=f"edges {', '.join(loc.edges)} of {loc.net.name}: {axis.length:.2f} m", path=path,
-        extent=(middle[0] - half, middle[0] + half, middle[1] - half, middle[1] + half),
-    )

@@ -5,8 +5,6 @@ import argparse
 import textwrap
 from pathlib import Path
 
-from cosim.errors import CosimError
-
 from .options import FORMATTER, Subcommands
 
 NAME = "layout"
@@ -40,19 +38,10 @@ def add_parser(commands: Subcommands) -> None:
 
 def cmd_layout(args: argparse.Namespace) -> int:
     """Write the layout of a log's run (made from what the log records, as the run attached it)."""
-    from cosim.log.layout import inputs_from_log, layout_bytes, make_layout
-    from cosim.log.reader import open_log
-    from cosim.run.outputs import atomic_write, check_new_file, check_not_input
+    from cosim.run.export import write_layout
 
     log, out = Path(args.log), Path(args.output)
-    check_not_input(out, "layout", [("the log", log)])
-    if out.suffix.lower() != ".json":
-        raise CosimError(f"{out}: a Foxglove layout is a JSON file: expected a name ending in .json")
-    overview = open_log(log)
-    inputs = inputs_from_log(overview)
-    check_new_file(out, "layout", args.force)
-    with atomic_write(out, "layout") as partial:
-        partial.write_bytes(layout_bytes(make_layout(inputs)))
+    inputs = write_layout(log, out, force=args.force)
     panels = ["a plot per sensor quantity" if inputs.sensors else "", "contact forces",
               "SUMO traffic" if inputs.sumo else "vehicle positions", "the vehicles on the deck", "events, status",
               "the 3D scene" if inputs.scene else ""]

@@ -72,19 +72,11 @@ def theory_lines(bridge: BridgeModel) -> list[str]:
 
 def cmd_modes(args: argparse.Namespace) -> int:
     """Print the modes of a scenario's bridge (``--json``: only JSON); ``--plot`` draws the first shapes."""
-    from cosim import plots
-    from cosim.run.figures import plot_modes
-    from cosim.run.inputs import scenario_files
-    from cosim.run.outputs import check_not_input, check_writable
+    from cosim.run.api import bridge_modes
     from cosim.run.payloads import SHAPE_NOTE, damping_payload, jsonable, modes_payload, section_payload
-    from cosim.run.scenario import load_scenario
 
-    scenario = load_scenario(args.scenario)
-    if args.plot:
-        check_not_input(args.plot, "plot", scenario_files(scenario))
-        check_writable(args.plot, "plot", plots.figure_formats(), force=args.force)
-    bridge = scenario.build_bridge()
-    modal = bridge.modes(count=args.count)
+    done = bridge_modes(args.scenario, args.count, plot=args.plot, force=args.force)
+    scenario, bridge, modal = done.scenario, done.bridge, done.modal
     if args.json:
         payload = {
             "scenario": scenario.title,
@@ -103,8 +95,6 @@ def cmd_modes(args: argparse.Namespace) -> int:
         print_lines(theory_lines(bridge))
         print_lines(["", *damping_lines(bridge), ""])
         print_lines(modes_lines(modal))
-    if args.plot:
-        plotted = plot_modes(bridge, modal, args.plot, args.count)
-        if not args.json:
-            print(f"\nWrote {plotted} mode shape(s) to {args.plot}")
+    if args.plot and not args.json:
+        print(f"\nWrote {done.plotted} mode shape(s) to {args.plot}")
     return 0

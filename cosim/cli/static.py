@@ -50,15 +50,12 @@ def add_parser(commands: Subcommands) -> None:
 
 def cmd_static(args: argparse.Namespace) -> int:
     """Solve the scenario's bridge under the ``--load`` point loads together; print the deck displacements."""
-    from cosim.core.bridge import PointLoad
+    from cosim.run.api import static_loads
     from cosim.run.payloads import jsonable
-    from cosim.run.scenario import load_scenario
-    from cosim.run.static import STATIC_UNITS, static_response
+    from cosim.run.static import STATIC_UNITS
 
-    scenario = load_scenario(args.scenario)
-    loads = [PointLoad(x=x, y=y, Fz=fz) for x, y, fz in args.load]
-    bridge = scenario.build_bridge()
-    response = static_response(scenario, bridge, loads)
+    done = static_loads(args.scenario, args.load)
+    scenario, bridge, response = done.scenario, done.bridge, done.response
     if args.json:
         payload = {
             "scenario": scenario.title,

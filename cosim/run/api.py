@@ -1,34 +1,41 @@
-"""A scenario run as one call, what ``cosim run`` does: :func:`run_scenario`.
+"""What is done with a scenario, one call each: the command line's ``cosim run``, ``modes`` and ``static``.
 
-With ``[[vehicles]]`` or ``[traffic]`` it checks every output, reads SUMO's
-network and vehicle types, builds the bridge, streams the run into its MCAP
-log (:func:`cosim.run.logged.run_logged`) and writes the sensor CSV
-(:class:`LoggedRun`); without, it computes the modes and the static load case
-(:class:`StaticRun`). It returns what happened and prints nothing: callbacks
-say when the scenario is checked and when the time stepping is about to
-start (:class:`RunStart`, shared with :func:`cosim.run.replay.replay_log`),
-so that the command line can show a run's header before a long run.
+- :func:`run_scenario` (``cosim run``): with ``[[vehicles]]`` or ``[traffic]``
+  it checks every output, reads SUMO's network and vehicle types, builds the
+  bridge, streams the run into its MCAP log
+  (:func:`cosim.run.logged.run_logged`) and writes the sensor CSV
+  (:class:`LoggedRun`); without, it computes the modes and the static load
+  case (:class:`StaticRun`). Callbacks say when the scenario is checked and
+  when the time stepping is about to start (:class:`RunStart`, shared with
+  :func:`cosim.run.replay.replay_log`), so that the command line can show a
+  run's header before a long run.
+- :func:`bridge_modes` (``cosim modes``): the bridge's lowest modes, and a figure of their shapes.
+- :func:`static_loads` (``cosim static``): the deck under point loads anywhere on it.
+
+Each returns a frozen outcome and prints nothing.
 """
 from __future__ import annotations
 
 import json
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cosim.core.bridge import BridgeModel, ModalResult
+from cosim import plots
+from cosim.core.bridge import BridgeModel, ModalResult, PointLoad
 from cosim.errors import CosimError
 
 from .export import export_csv
+from .figures import plot_modes
 from .inputs import scenario_files
 from .logged import RunOutcome, run_logged
 from .outputs import atomic_write, check_new_file, check_not_input, check_writable, unique_path
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import Scenario, load_scenario
 from .simulate import SumoPlan, plan_sumo
-from .static import static_cases
+from .static import static_cases, static_response
 
 #: What a run of a scenario without vehicles does instead of a time simulation.
 NO_VEHICLES = (
@@ -212,3 +219,67 @@ def _static_run(scenario: Scenario, out: str | os.PathLike[str] | None, csv: str
     with atomic_write(out, "summary") as partial:
         partial.write_text(json.dumps(jsonable(summary), indent=2) + "\n", encoding="utf-8")
     return StaticRun(scenario, bridge, modal, cases, Path(out))
+
+
+@dataclass(frozen=True)
+class BridgeModes:
+    """A scenario's bridge and its lowest natural modes (``cosim modes``).
+
+    Attributes:
+        scenario, bridge: the scenario and its model.
+        modal: the lowest modes: frequencies, kinds, effective modal mass fractions, shapes.
+        plotted: how many mode shapes the figure shows (0: no figure asked for).
+    """
+
+    scenario: Scenario
+    bridge: BridgeModel
+    modal: ModalResult
+    plotted: int = 0
+
+
+def bridge_modes(scenario: str | os.PathLike[str] | Scenario, count: int = 10, *,
+                 plot: str | os.PathLike[str] | None = None, force: bool = False) -> BridgeModes:
+    """Build a scenario's bridge and compute its lowest ``count`` modes; ``plot``: draw the first shapes there.
+
+    Raises:
+        CosimError (ConfigError, ModelError, ...): a bad scenario, or a figure that may not be written (checked
+            before the bridge is built).
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    if plot:
+        check_not_input(plot, "plot", scenario_files(scenario))
+        check_writable(plot, "plot", plots.figure_formats(), force=force)
+    bridge = scenario.build_bridge()
+    modal = bridge.modes(count=count)
+    plotted = plot_modes(bridge, modal, plot, count) if plot else 0
+    return BridgeModes(scenario, bridge, modal, plotted)
+
+
+@dataclass(frozen=True)
+class StaticLoads:
+    """A scenario's deck under vertical point loads acting together (``cosim static``).
+
+    Attributes:
+        scenario, bridge: the scenario and its model.
+        response: the deck displacement under each load and at each sensor
+            (:func:`cosim.run.static.static_response`).
+    """
+
+    scenario: Scenario
+    bridge: BridgeModel
+    response: dict[str, Any]
+
+
+def static_loads(scenario: str | os.PathLike[str] | Scenario,
+                 loads: Sequence[tuple[float, float, float]]) -> StaticLoads:
+    """Solve a scenario's bridge under point loads ``(x, y, Fz)`` (m, m, N positive up) acting together.
+
+    Raises:
+        CosimError (ConfigError, ...): a bad scenario, or a load that is not finite or lies off the deck.
+    """
+    if not isinstance(scenario, Scenario):
+        scenario = load_scenario(scenario)
+    points = [PointLoad(x=x, y=y, Fz=fz) for x, y, fz in loads]
+    bridge = scenario.build_bridge()
+    return StaticLoads(scenario, bridge, static_response(scenario, bridge, points))
