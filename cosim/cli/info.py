@@ -6,13 +6,14 @@ import json
 import textwrap
 from typing import TYPE_CHECKING
 
-from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_TRAFFIC
+from cosim.log.schemas import REPLAY_METADATA_NAME
 
 from .options import FORMATTER, Subcommands
 from .text import fmt_g, print_lines, size_text
 
 if TYPE_CHECKING:
     from cosim.log.reader import LogOverview
+    from cosim.run.loginfo import DeckVehicles, LogInfo
 
 NAME = "info"
 
@@ -45,9 +46,9 @@ def add_parser(commands: Subcommands) -> None:
 
 def cmd_info(args: argparse.Namespace) -> int:
     """Summarise a log: from its summary, or (``--verify``) from every chunk."""
-    from cosim.log.reader import open_log
+    from cosim.run.loginfo import log_info
 
-    print_lines(info_lines(open_log(args.log, check="full" if args.verify else "file")))
+    print_lines(info_lines(log_info(args.log, verify=args.verify)))
     return 0
 
 
@@ -69,8 +70,9 @@ def checked_line(o: LogOverview, extra_chunks: int = 0) -> str:
             f"decompressed{unread}{older}; counts from the summary (--verify: every chunk)")
 
 
-def info_lines(o: LogOverview) -> list[str]:
+def info_lines(log: LogInfo) -> list[str]:
     """The lines of ``cosim info``."""
+    o = log.overview
     info = o.info
     lines = [f"Log: {o.path} ({size_text(o.size)}, {'finished file' if o.complete else 'TRUNCATED'})"]
     if info:
@@ -95,9 +97,9 @@ def info_lines(o: LogOverview) -> list[str]:
     sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
     lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
     extra_chunks = 0
-    if o.counts.get(TOPIC_TRAFFIC) or info.get("traffic") == "sumo":
-        vehicle_lines, extra_chunks = _sumo_vehicle_lines(o)
-        lines.extend(vehicle_lines)
+    if log.deck is not None:
+        lines.extend(_sumo_vehicle_lines(o, log.deck))
+        extra_chunks = log.deck.chunks
     elif "vehicles" in info:
         try:
             vehicles = json.loads(info["vehicles"])
@@ -127,43 +129,18 @@ def info_lines(o: LogOverview) -> list[str]:
 
 #: SUMO vehicles listed by name in ``cosim info`` (the rest are counted).
 SHOWN_VEHICLES = 20
-#: Chunks ``cosim info`` (without --verify) reads for the SUMO vehicles' events: about 20 min of the default run.
-EVENT_CHUNKS = 256
 
 
-def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
-    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run,
-    and the chunks read for them.
-
-    Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
-    thousands): the vehicles of a long log are those of its start, and the line says so.
-    """
-    from cosim.core.traffic import vehicle_of
-    from cosim.log.reader import iter_messages
-    from cosim.log.records import ReadStats
+def _sumo_vehicle_lines(o: LogOverview, deck: DeckVehicles) -> list[str]:
+    """The SUMO vehicles that were on the deck (without ``--verify``: those of the log's start, and the line
+    says so) and the vehicle types of the run."""
     from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 
-    axles: dict[str, int] = {}
-    stats = ReadStats()
-    budget = None if o.check == "full" else EVENT_CHUNKS
-    last_t, cut = 0.0, False
-    if o.counts.get(TOPIC_EVENTS):
-        # A window over the whole log: a finished log's chunks are then read through its index, one at a time.
-        messages = iter_messages(o.path, [TOPIC_EVENTS], start=o.start_time, stats=stats)
-        for _, message in messages:
-            if budget is not None and stats.chunks > budget:
-                cut = True
-                break
-            last_t = float(message["t"])
-            if message.get("event") == "entered":
-                contact = str(message.get("vehicle", ""))
-                axles.setdefault(contact, 0)
-        messages.close()  # type: ignore[attr-defined]
-    vehicles = list(dict.fromkeys(vehicle_of(c) for c in axles))
+    vehicles = deck.vehicles
     shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"
                                                     if len(vehicles) > SHOWN_VEHICLES else "")
-    axle_text = f", {len(axles)} axles" if len(axles) != len(vehicles) else ""
-    when = f", in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
+    axle_text = f", {deck.axles} axles" if deck.axles != len(vehicles) else ""
+    when = f", in its first {fmt_g(deck.until, 6)} s (--verify: the whole log)" if deck.until is not None else ""
     lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{axle_text}{when}): {shown or 'none'}"]
     raw = o.attachments.get(VEHICLE_TYPES_ATTACHMENT)
     if raw is not None:
@@ -174,4 +151,4 @@ def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
             lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
-    return lines, stats.chunks
+    return lines
