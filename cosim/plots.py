@@ -11,12 +11,12 @@ import os
 import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING, Any
 
 from cosim.errors import CosimError
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 # --------------------------------------------------------------------------- common
 
@@ -75,6 +75,8 @@ def mode_shapes(x: npt.ArrayLike, shapes: Sequence[Mapping[str, npt.ArrayLike]],
     Returns:
         The number of modes drawn.
     """
+    import numpy as np
+
     x = np.asarray(x, dtype=float)
     n = min(len(shapes), MAX_MODE_SHAPES)
     fig = _figure(8.0, 2.0 * n + 0.8)
@@ -147,6 +149,8 @@ def network_figure(lanes: Sequence[npt.ArrayLike], junction_lanes: Sequence[npt.
         title: the figure's title; path: the figure file (its suffix picks the format).
         extent: (x_min, x_max, y_min, y_max) shown, m (default: everything drawn).
     """
+    import numpy as np
+
     fig = _figure(7.5, 6.5)
     ax = fig.add_subplot()
     for i, pts in enumerate(lanes):
@@ -252,6 +256,8 @@ def plot_sweep(
 
 def _sweep_panel(ax: Any, table: Any, axes: Mapping[str, Sequence[Any]], axis: str, others: list[str], column: str,
                  factor: float, ticks: Mapping[Any, str], band: bool) -> None:
+    import numpy as np
+
     values = list(axes[axis])
     numeric = all(isinstance(v, (int, float)) for v in values)
     positions = {v: (float(v) if numeric else float(i)) for i, v in enumerate(values)}
@@ -362,6 +368,8 @@ def validation_paper_node(
     duration: float,
 ) -> Path:
     """The paper case at one node: displacement histories (m) on top, the differences too small to see below."""
+    import numpy as np
+
     fig, axes = _validation_figure(2, 1, size=(8.0, 5.6), sharex=True, height_ratios=[3.0, 1.2])
     top, bottom = axes[0, 0], axes[1, 0]
     t, w_qc, w_modal, w_mf = (np.asarray(a, dtype=float) for a in (t, w_qc, w_modal, w_mf))
@@ -396,6 +404,8 @@ def validation_paper_asymmetric(
     duration: float,
 ) -> Path:
     """The paper case's asymmetric section (solid) against the symmetric one (dotted), one colour per node."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(8.0, 4.8))
     ax = axes[0, 0]
     for i, (label, w) in enumerate(zip(labels, w_asymmetric)):
@@ -419,6 +429,8 @@ def validation_timoshenko_static(
     cantilever_bending_only: npt.ArrayLike, cantilever_nodes_x: npt.ArrayLike, cantilever_fe: npt.ArrayLike,
 ) -> Path:
     """Static deflection (m): closed forms as lines, FE nodal values as circles; simply supported and cantilever."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, 2, size=(10.0, 4.0))
     ax = axes[0, 0]
     for k, (a_over_l, closed, fe) in enumerate(zip(ss_loads, ss_closed, ss_fe)):
@@ -446,6 +458,8 @@ def validation_torsion_static(
     closed: Sequence[npt.ArrayLike], nodes_x: npt.ArrayLike, fe: Sequence[npt.ArrayLike],
 ) -> Path:
     """Twist (rad) under a mid-span torque: uniform torsion, Vlasov closed forms and FE nodes."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(8.0, 4.2))
     ax = axes[0, 0]
     ax.plot(x, 1e3 * np.asarray(uniform), ":", color="0.5", label="uniform (St Venant) torsion only")
@@ -466,6 +480,8 @@ def validation_fryba(
     w_static: float,
 ) -> Path:
     """Mid-span deflection (m) under a moving force against Fryba's series, one panel per speed parameter."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, len(speed_parameters), size=(10.0, 4.0))
     for k, (alpha, v, pos, fe, ref) in enumerate(zip(speed_parameters, speeds, position, w_fe, w_ref)):
         ax = axes[0, k]
@@ -484,6 +500,8 @@ def validation_sprung_mass(
     t_body: npt.ArrayLike, a_fe: npt.ArrayLike, a_ref: npt.ArrayLike,
 ) -> Path:
     """The sprung mass: mid-span deflection (m, left) and body acceleration (m/s^2, right), FE and reference."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, 2, size=(10.0, 4.0))
     ax = axes[0, 0]
     ax.plot(t, 1e3 * np.asarray(w_fe), "-", color="C0", lw=1.6, label="FE, direct basis")
@@ -508,6 +526,8 @@ def validation_energy(
     strain: npt.ArrayLike, drift: npt.ArrayLike,
 ) -> Path:
     """Kinetic, strain and total energy (J, top) and the relative drift of the total (bottom)."""
+    import numpy as np
+
     fig, axes = _validation_figure(2, 1, size=(8.0, 5.2), sharex=True)
     top, bottom = axes[0, 0], axes[1, 0]
     kinetic, strain = np.asarray(kinetic, dtype=float), np.asarray(strain, dtype=float)
@@ -529,6 +549,8 @@ def validation_time_step(
     path: str | Path, *, title: str, dt: npt.ArrayLike, labels: Sequence[str], errors: Sequence[npt.ArrayLike],
 ) -> Path:
     """Error (m) against the time step (log-log) per model and scheme, with a slope-2 line."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(7.0, 5.0))
     ax = axes[0, 0]
     dt = np.asarray(dt, dtype=float)
@@ -551,6 +573,8 @@ def validation_roughness(
     psd: Sequence[npt.ArrayLike],
 ) -> Path:
     """Third-octave PSDs of generated profiles (m^3) with their ISO 8608 class values and bands."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(8.0, 5.0))
     ax = axes[0, 0]
     n_line = np.logspace(np.log10(n_range[0]), np.log10(n_range[1]), 200)
@@ -578,6 +602,8 @@ def validation_mesh(
     errors: Sequence[npt.ArrayLike], expected_orders: Sequence[float],
 ) -> Path:
     """Relative frequency error against the element count (log-log), with the expected slopes dashed."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(7.0, 5.0))
     ax = axes[0, 0]
     for k, (label, n, err, order) in enumerate(zip(labels, counts, errors, expected_orders)):
@@ -597,6 +623,8 @@ def validation_parked(
     path: str | Path, *, title: str, t: npt.ArrayLike, w: npt.ArrayLike, w_static: float, stop_time: float,
 ) -> Path:
     """Deflection under the wheel (m) of a vehicle braking to a stop, against the static deflection."""
+    import numpy as np
+
     fig, axes = _validation_figure(size=(8.0, 3.8))
     ax = axes[0, 0]
     ax.plot(t, 1e3 * np.asarray(w), "-", color="C0", lw=1.2, label="FE, under the wheel (x = 10 m, y = 0.3 m)")
@@ -617,6 +645,8 @@ def validation_benscoter(
     mesh_label: str, counts: npt.ArrayLike, errors: npt.ArrayLike, expected_order: float,
 ) -> Path:
     """Benscoter torsion: twist (rad) under a mid-span torque, torsional frequencies (Hz), mesh convergence."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, 3, size=(14.0, 4.2))
     ax = axes[0, 0]
     for k, (name, line, line_vlasov, nodal) in enumerate(zip(warping, closed, vlasov, fe)):
@@ -654,6 +684,8 @@ def validation_paper_theories(
     t: Sequence[npt.ArrayLike], w: Sequence[npt.ArrayLike], duration: float,
 ) -> Path:
     """The paper case under moving forces with each torsion theory: mid-span histories (m), one panel per node."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, len(node_titles), size=(14.0, 4.0), sharey=True)
     styles = ("-", "--", ":", "-.")
     for i, node_title in enumerate(node_titles):
@@ -675,6 +707,8 @@ def validation_vbi2d(
     a_ref: npt.ArrayLike,
 ) -> Path:
     """VBI-2D's sprung vehicle: mid-span deflection (m) with the published peak (left), body acceleration (right)."""
+    import numpy as np
+
     fig, axes = _validation_figure(1, 2, size=(10.0, 4.0))
     ax = axes[0, 0]
     ax.plot(t, 1e3 * np.asarray(w_fe), "-", color="C0", lw=1.6, label=f"cosim, Euler-Bernoulli, {n_elements} elements")

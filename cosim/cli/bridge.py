@@ -13,33 +13,71 @@ import argparse
 import json
 import math
 import shlex
+import textwrap
 from pathlib import Path
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from cosim.errors import CosimError
-from cosim.plots import network_figure
-from cosim.run.outputs import check_new_file
-from cosim.sumo.network import (
-    BridgeLocation,
-    bridge_candidates,
-    edge_options,
-    lane_shapes,
-    locate_bridge,
-    net_path,
-    wheel_paths_beyond,
-)
 
+from .options import FORMATTER, DashValue, Subcommands, positive_int
 from .text import print_lines
 
+if TYPE_CHECKING:
+    from cosim.sumo.network import BridgeLocation
+
+NAME = "bridge"
+#: ``--edge -148050455#0``: a SUMO edge id beginning with "-" is a value (:func:`cosim.cli.options.dash_values_kept`).
+DASH_VALUES = {"--edge": DashValue(numbers=False)}
 #: Candidates listed without --count.
 DEFAULT_COUNT = 15
-#: The plot shows the network this far beyond the deck's ends, m.
-PLOT_MARGIN = 60.0
+
+
+def add_parser(commands: Subcommands) -> None:
+    """``cosim bridge``: its arguments and help."""
+    bridge = commands.add_parser(
+        "bridge",
+        help="find a bridge in a SUMO network: candidates, or one bridge's axis, lanes and scenario lines",
+        description=textwrap.dedent(
+            """\
+            Without --edge: list candidate bridges of a SUMO network (or of the network a
+            .sumocfg names): two-way edge pairs between two junctions and one-way edges,
+            with length, lanes, street names and the OSM bridge attribute where the network
+            kept them; edges marked as OSM bridges first, then the nearest to --near X Y
+            (network coordinates), else the longest.
+
+            With --edge (repeat it for each edge the deck carries): the bridge's axis (the
+            carriageway's centre line, x = 0 where the named lanes begin, +x the first edge's
+            direction of travel), length, lanes and their lateral positions, the junctions at
+            its ends, and the [bridge]/[traffic] lines to paste into a scenario; --plot draws
+            the network around it with the deck outline, the axis and the lanes."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim bridge city.sumocfg --near 720 230
+              cosim bridge city.sumocfg --edge 39 --edge 40
+              cosim bridge city.net.xml.gz --edge 113 --edge "43[1]" --plot bridge.png
+            """
+        ),
+        formatter_class=FORMATTER,
+    )
+    bridge.add_argument("network", metavar="NET_OR_SUMOCFG", help="a SUMO network (.net.xml[.gz]) or config (.sumocfg)")
+    bridge.add_argument("--edge", action="append", metavar="ID", help="an edge the deck carries (repeat for more)")
+    bridge.add_argument("--near", nargs=2, type=float, metavar=("X", "Y"),
+                        help="list the candidates nearest to this point (network coordinates, m) first")
+    bridge.add_argument("--count", "-n", type=positive_int, metavar="N",
+                        help=f"candidates to list (default: {DEFAULT_COUNT})")
+    bridge.add_argument("--plot", metavar="FIG.png", help="draw the network around the bridge (needs --edge)")
+    bridge.add_argument("--force", "-f", action="store_true", help="overwrite FIG if it exists")
+    bridge.set_defaults(func=cmd_bridge)
 
 
 def cmd_bridge(args: argparse.Namespace) -> int:
     """List candidate bridges, or describe one and print its scenario lines."""
+    from cosim.run.figures import plot_bridge_location
+    from cosim.run.outputs import check_new_file
+    from cosim.sumo.network import locate_bridge, net_path
+
     source = Path(args.network)
     if not source.is_file():
         raise CosimError(f"{source}: no such file (give a SUMO network, .net.xml[.gz], or a config, .sumocfg)")
@@ -54,12 +92,14 @@ def cmd_bridge(args: argparse.Namespace) -> int:
     location = locate_bridge(net, args.edge)
     print_lines(_location_lines(location, source, args))
     if args.plot is not None:
-        _plot(location, Path(args.plot))
+        plot_bridge_location(location, Path(args.plot))
         print(f"\nWrote the network around the bridge to {args.plot}")
     return 0
 
 
 def _candidate_lines(net: Path, args: argparse.Namespace) -> list[str]:
+    from cosim.sumo.network import bridge_candidates, edge_options
+
     near = tuple(args.near) if args.near is not None else None
     found = bridge_candidates(net, near=near)
     count = args.count or DEFAULT_COUNT
@@ -86,6 +126,8 @@ def _candidate_lines(net: Path, args: argparse.Namespace) -> list[str]:
 
 
 def _location_lines(loc: BridgeLocation, source: Path, args: argparse.Namespace) -> list[str]:
+    from cosim.sumo.network import wheel_paths_beyond
+
     axis = loc.axis
     (x0, y0), (x1, y1) = axis.start, axis.end
     heading = math.degrees(math.atan2(y1 - y0, x1 - x0))
@@ -136,22 +178,3 @@ def _location_lines(loc: BridgeLocation, source: Path, args: argparse.Namespace)
     ]
     return lines
 
-
-def _plot(loc: BridgeLocation, path: Path) -> None:
-    axis = loc.axis
-    middle = tuple(0.5 * (np.asarray(axis.start) + np.asarray(axis.end)))
-    half = 0.5 * axis.length + PLOT_MARGIN
-    shapes = lane_shapes(loc.net, (float(middle[0]), float(middle[1])), half)
-    deck_ids = set(loc.deck_lanes)
-    e, n = axis.unit()
-    lo, hi = loc.carriageway
-    s = np.asarray(axis.start, dtype=float)
-    corners = [s + lo * n, s + axis.length * e + lo * n, s + axis.length * e + hi * n, s + hi * n, s + lo * n]
-    network_figure(
-        lanes=[pts for lid, pts in shapes if lid not in deck_ids and not lid.startswith(":")],
-        junction_lanes=[pts for lid, pts in shapes if lid.startswith(":")],
-        deck_lanes=[pts for lid, pts in shapes if lid in deck_ids],
-        outline=np.array(corners), axis=np.array([axis.start, axis.end]),
-        title=f"edges {', '.join(loc.edges)} of {loc.net.name}: {axis.length:.2f} m", path=path,
-        extent=(middle[0] - half, middle[0] + half, middle[1] - half, middle[1] + half),
-    )

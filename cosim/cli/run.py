@@ -1,102 +1,130 @@
-"""``cosim run`` and ``cosim replay``: a run (or a replay) into an MCAP log with its summary, or a static case.
+"""``cosim run``: a scenario run into an MCAP log with its summary, or (without vehicles) its modes and a
+static case.
 
-The work is :mod:`cosim.run` (:func:`cosim.run.logged.run_logged`,
-:func:`cosim.run.replay.replay_scenario`, :func:`cosim.run.static.static_cases`);
-this module checks the outputs first, shows the progress and prints.
+The run is one call, :func:`cosim.run.api.run_scenario`, which checks, builds,
+runs and writes; this module shows the run's header and progress through the
+call's callbacks (:mod:`.summary`) and prints what it returns.
 """
 from __future__ import annotations
 
 import argparse
-import json
-import sys
-import tempfile
-from pathlib import Path
-from typing import Any
+import textwrap
+from typing import TYPE_CHECKING, Any
 
-from cosim.core.bridge import BridgeModel
-from cosim.core.traffic import vehicle_of
-from cosim.errors import CosimError
-from cosim.run.export import export_csv
-from cosim.run.inputs import scenario_files
-from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome, run_logged
-from cosim.run.outputs import atomic_write, check_new_file, check_not_input, check_writable, unique_path
-from cosim.run.payloads import damping_payload, jsonable, modes_payload, section_payload
-from cosim.run.replay import Comparison, compare_sensors, replay_scenario
-from cosim.run.scenario import Scenario, load_scenario
-from cosim.run.simulate import SumoPlan, plan_sumo
-from cosim.run.static import STATIC_LOAD_N, static_cases
-from cosim.run.units import display_unit
+from cosim.run.static import STATIC_LOAD_N
 
-from .text import (
-    EXIT_RUN_FAILED,
-    damping_lines,
-    fmt_g,
-    modes_lines,
-    print_lines,
-    report_error,
-    scenario_line,
-    size_text,
-)
+from .options import FORMATTER, Subcommands, bundled_text
+from .text import damping_lines, modes_lines, print_lines, scenario_line
 
+if TYPE_CHECKING:
+    from cosim.run.scenario import Scenario
+
+NAME = "run"
 #: The scenario of ``cosim run`` without one.
 DEFAULT_SCENARIO = "paper-bridge-traffic"
-NO_VEHICLES = (
-    "the scenario has no [[vehicles]]; "
-    "this run does the modal analysis and a static load case"
-)
+
+
+def add_parser(commands: Subcommands) -> None:
+    """``cosim run``: its arguments and help."""
+    run = commands.add_parser(
+        "run",
+        help="run a scenario into an MCAP log (or, without vehicles, modes and a static case)",
+        description=textwrap.dedent(
+            f"""\
+            Run a scenario; without SCENARIO, the bundled '{DEFAULT_SCENARIO}': the paper's
+            40 m double-tee bridge under 10 minutes of medium two-way SUMO traffic on an
+            ISO 8608 class A road.
+
+            With [[vehicles]] (scripted) or [traffic] (SUMO): integrate the coupled vehicle-bridge equations in time and
+            stream everything into an MCAP log: sensor samples, vehicles on the deck with
+            their contact forces, traffic events (entered/left the deck, lift-off) and the
+            run's status, with the scenario, its input files, resolved parameters, section
+            constants and frequencies embedded (a log alone is enough to run it again:
+            cosim replay). Then print a summary: sensor peaks, each vehicle's contact force
+            and whether it lifted off, steps, wall time, real-time factor. A progress
+            display goes to stderr. The log is finished whatever ends the run: Ctrl-C,
+            SIGTERM or SIGHUP leave status "interrupted", a diverging solution status
+            "error" with its likely cause. An existing file is replaced only with --force,
+            and never the scenario or its input files.
+
+            Without [[vehicles]]: the modal analysis (first 10 modes) and a static load
+            case, a {STATIC_LOAD_N / 1e3:g} kN downward point load at mid-span of the longest span, once
+            on the bridge axis (y = 0) and once at the left deck edge (largest y),
+            with each sensor's deck displacement for both (no log).
+
+            Exit status: 0 done, 1 the run failed after it started (the log ends with
+            status "error"), 2 bad input, SUMO's included (nothing is written), 128 + N
+            stopped by signal N: 130 Ctrl-C, 143 SIGTERM, 129 SIGHUP (the log ends with
+            status "interrupted"; nothing is written if the run had not started)."""
+        ),
+        epilog=textwrap.dedent(
+            f"""\
+            examples:
+              cosim run                              # the default traffic run
+                                                     # -> runs/{DEFAULT_SCENARIO}-<date>-<time>.mcap
+              cosim run paper-double-tee             # the paper's two quarter-cars
+              cosim run my-bridge.toml --out results/run1.mcap --csv results/run1.csv
+              cosim run my-bridge-no-vehicles.toml --out summary.json
+            """
+        )
+        + "\n"
+        + bundled_text(),
+        formatter_class=FORMATTER,
+    )
+    run.add_argument("scenario", metavar="SCENARIO", nargs="?", default=DEFAULT_SCENARIO,
+                     help=f"scenario file (.toml) or bundled scenario name (default: {DEFAULT_SCENARIO})")
+    run.add_argument("--out", metavar="PATH",
+                     help="with vehicles: the MCAP log, LOG.mcap (default: [output].log, else "
+                          "runs/<scenario name>-<YYYYmmdd-HHMMSS>.mcap; its folder is created); without "
+                          "vehicles: write the modes and static displacements as JSON to PATH")
+    run.add_argument("--csv", metavar="OUT.csv",
+                     help="also write the sensor channels as CSV, columns t,<sensor names> (default: [output].csv "
+                          "if given); the same as 'cosim export LOG --csv OUT.csv' after the run")
+    run.add_argument("--force", "-f", action="store_true",
+                     help="overwrite the log, the CSV or the summary if they exist (default: refuse; never "
+                          "the scenario or its input files)")
+    run.add_argument("--quiet", "-q", action="store_true",
+                     help="no progress display on stderr")
+    run.set_defaults(func=cmd_run)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     """With vehicles or traffic: the logged time simulation and its summary; without: modes and a static case."""
-    if args.out is not None and Path(args.out).suffix.lower() == ".csv":
-        raise CosimError(
-            f"{args.out}: --out is the run's MCAP log (LOG.mcap); for a CSV of the sensors give --csv {args.out}"
-        )
-    scenario = load_scenario(args.scenario)
-    if scenario.vehicles or scenario.traffic is not None:
-        return _run_vehicles(scenario, args)
-    return _run_static(scenario, args)
+    from cosim.run.api import NO_VEHICLES, StaticRun, run_scenario
+    from cosim.run.logged import RunFailed, RunInterrupted
 
+    from .summary import RunDisplay, print_outcome
 
-def _run_static(scenario: Scenario, args: argparse.Namespace) -> int:
-    """Without vehicles: the modes and a static load case; ``--out`` writes them as JSON (no log)."""
-    if args.out is not None and Path(args.out).suffix.lower() == ".mcap":
-        raise CosimError(
-            f"{args.out}: the scenario has no [[vehicles]], so there is no time simulation to log; "
-            "--out writes the modes and static displacements as JSON (e.g. --out summary.json)"
-        )
-    if args.csv is not None:
-        raise CosimError(f"{args.csv}: the scenario has no [[vehicles]]: no sensor time histories for --csv")
-    if args.out is not None:
-        check_not_input(args.out, "summary", scenario_files(scenario))
-        check_writable(args.out, "summary", force=args.force)
-    print(scenario_line(scenario))
-    print(f"note: {NO_VEHICLES}")
-    bridge = scenario.build_bridge()
-    modal = bridge.modes(count=10)
-    cases = static_cases(scenario, bridge)
-    print_lines(["", *damping_lines(bridge), ""])
-    print_lines(modes_lines(modal))
-    print()
-    print_lines(_static_lines(scenario, cases))
-    if args.out is not None:
-        summary = {
-            "scenario": scenario.title,
-            "source": scenario.source,
-            "note": NO_VEHICLES,
-            "section": section_payload(bridge.section),
-            "damping": damping_payload(bridge),
-            "modes": modes_payload(modal),
-            "static": cases,
-            "units": {"x": "m", "y": "m", "Fz": "N", "w": "m (positive up)", "f_hz": "Hz"},
-        }
-        with atomic_write(args.out, "summary") as partial:
-            partial.write_text(json.dumps(jsonable(summary), indent=2) + "\n", encoding="utf-8")
-        print(f"\nWrote the summary to {args.out}")
+    display = RunDisplay(quiet=args.quiet)
+
+    def checked(scenario: Scenario) -> None:
+        print(scenario_line(scenario))
+        if not scenario.vehicles and scenario.traffic is None:
+            print(f"note: {NO_VEHICLES}")
+
+    try:
+        done = run_scenario(args.scenario, out=args.out, csv=args.csv, force=args.force, checked=checked,
+                            ready=display.ready, progress=display)
+    except (RunFailed, RunInterrupted) as exc:
+        return display.stopped(exc)
+    finally:
+        display.close()
+    if isinstance(done, StaticRun):
+        print_lines(["", *damping_lines(done.bridge), ""])
+        print_lines(modes_lines(done.modal))
+        print()
+        print_lines(_static_lines(done.scenario, done.cases))
+        if args.out is not None:
+            print(f"\nWrote the summary to {args.out}")
+        return 0
+    print_outcome(done.outcome)
+    if done.csv_path is not None:
+        print(f"Wrote {done.csv_rows} rows to {done.csv_path} (columns {','.join(done.csv_columns)}; "
+              "SI units: m, m/s, m/s^2, N m)")
     return 0
 
 
-def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
+def _static_lines(scenario: Scenario, cases: tuple[dict[str, Any], ...]) -> list[str]:
     load = cases[0]["load"]
     heads = [f"load at y = {c['load']['y']:g} m" for c in cases]
     lines = [
@@ -113,425 +141,4 @@ def _static_lines(scenario: Scenario, cases: list[dict[str, Any]]) -> list[str]:
         lines.append(f"  {name:<{width}}{quantity:<16}{x:8.3f}{y_text}" + "".join(f"{1e3 * v:22.4f}" for v in values))
     if not scenario.sensors:
         lines.append("  (the scenario has no [[sensors]]; only the load point is reported)")
-    return lines
-
-
-class Progress:
-    """Progress of a run on stderr: a tqdm bar on a terminal, a line of percentages otherwise.
-
-    It appears with the first block of time steps: a run refused while it is
-    being set up (bad input, a limit, SUMO) prints its one error line alone.
-    """
-
-    def __init__(self, duration: float, show: bool) -> None:
-        self.duration = duration
-        self.fraction = 0.0
-        self._stream = sys.stderr
-        self._bar: Any = None
-        self._tenths: int | None = None  # the light form: tenths printed so far
-        self._show = show
-
-    def _start(self) -> None:
-        self._show = False
-        if self._stream.isatty():
-            from tqdm import tqdm
-
-            self._bar = tqdm(
-                total=self.duration, file=self._stream, desc="Simulating", leave=True, dynamic_ncols=True,
-                bar_format="{desc} {percentage:3.0f}%|{bar}| {n:.1f}/{total:.1f} s [{elapsed}<{remaining}]",
-            )
-        else:
-            self._tenths = 0
-            print(f"Simulating {self.duration:g} s:", end="", file=self._stream, flush=True)
-
-    def __call__(self, fraction: float) -> None:
-        self.fraction = fraction
-        if self._show:
-            self._start()
-        if self._bar is not None:
-            self._bar.update(min(fraction * self.duration, self.duration) - self._bar.n)
-        elif self._tenths is not None:
-            reached = int(fraction * 10 + 1e-9)
-            if reached > self._tenths:
-                self._tenths = reached
-                print(f" {10 * reached}%", end="", file=self._stream, flush=True)
-
-    def close(self) -> None:
-        if self._bar is not None:
-            self._bar.close()
-            self._bar = None
-        elif self._tenths is not None:
-            print(file=self._stream, flush=True)
-            self._tenths = None
-
-
-def _log_target(out: str | None, default: Path, force: bool) -> Path:
-    """The log to write: ``out`` (must end in .mcap) or ``default``; checked before any work."""
-    if out is not None:
-        path = Path(out)
-        if path.suffix.lower() != ".mcap":
-            raise CosimError(f"{out}: the log is an MCAP file: give a path ending in .mcap")
-    else:
-        path = default
-    check_new_file(path, "log", force)
-    return path
-
-
-def _parameter_text(key: str, value: Any, unit: str) -> str:
-    if key == "axles":
-        return f"{len(value)} axles at {', '.join(fmt_g(a.distance) for a in value)} m"
-    if key == "pitch":
-        return "pitch" if value else "no pitch"
-    if isinstance(value, bool):
-        return f"{key} = {'true' if value else 'false'}"
-    if isinstance(value, tuple):
-        return f"{len(value)} {key}"
-    return f"{key} = {fmt_g(value)} {unit}".rstrip()
-
-
-def _traffic_line(scenario: Scenario, plan: SumoPlan | None = None) -> str:
-    t = scenario.traffic
-    assert t is not None
-    level = f" (bundled {t.sumo_config} demand)" if t.bundled else ""
-    seed = f", seed {t.seed}" if t.seed is not None else ", the config's seed"
-    where = f"sumo_networks/{t.sumo_config}.sumocfg" if t.bundled else str(scenario.sumo_config_path)
-    if plan is not None:
-        start, end = plan.axis.start, plan.axis.end
-        axis = (f"bridge axis ({start[0]:.3f}, {start[1]:.3f}) -> ({end[0]:.3f}, {end[1]:.3f}) in network "
-                f"coordinates, {plan.axis.length:.3f} m ({plan.axis_from})")
-    elif t.axis is not None:
-        axis = f"bridge axis {t.axis[0]} -> {t.axis[1]} in network coordinates"
-    elif t.edges:
-        axis = f"bridge axis derived from edges {', '.join(t.edges)}"
-    else:
-        axis = f"bridge axis {(0.0, 0.0)} -> {(scenario.bridge.length, 0.0)} in network coordinates"
-    return (f"Traffic: SUMO {where}{level}, step {fmt_g(t.step)} s, SUMO time {fmt_g(t.begin)} to "
-            f"{fmt_g(t.end)} s{seed}; {axis}")
-
-
-def _sumo_lines(plan: SumoPlan) -> list[str]:
-    """Where the deck is in the network, and one line per vType: model, mass, axles and where each came from."""
-    lines = []
-    location = plan.location
-    if location is not None:
-        lanes = ", ".join(f"{lane.id} (y = {lane.y:+.2f} m, {'+x' if lane.direction > 0 else '-x'})"
-                          for lane in location.lanes)
-        also = f"; also watched: {', '.join(location.opposite)} (opposite direction)" if location.opposite else ""
-        lines.append(f"Deck lanes: {lanes}; carriageway y = {location.carriageway[0]:.2f} to "
-                     f"{location.carriageway[1]:.2f} m{also}")
-        from cosim.sumo.network import wheel_paths_beyond
-
-        beyond = wheel_paths_beyond(location, plan.deck_y)
-        if beyond:
-            lines.append(f"  {beyond}")
-    types = plan.types
-    lines.append(f"Vehicle types ({len(types)}): model, gross mass, axles, suspension, and where each came from "
-                 "(vType params, SUMO mass, cosim default)")
-    width = max([len(t.id) for t in types] + [4])
-    vwidth = max([len(t.vclass) for t in types] + [6])
-    for t in types:
-        lines.append(f"  {t.id:<{width}}  {t.vclass:<{vwidth}}  {t.line()}")
-    return lines
-
-
-def _vehicle_lines(scenario: Scenario, plan: SumoPlan | None = None) -> list[str]:
-    if scenario.traffic is not None:
-        return [_traffic_line(scenario, plan), *(_sumo_lines(plan) if plan is not None else [])]
-    rows = []
-    for v in scenario.vehicles:
-        if v.profile is not None:
-            speed = "profile " + " ".join(f"{fmt_g(t)}s:{fmt_g(vv)}" for t, vv in v.profile)
-        else:
-            speed = fmt_g(v.speed or 0.0)
-        params = ", ".join(_parameter_text(k, val, v.spec.parameter(k).unit) for k, val in v.parameters.items())
-        if v.contact == "unilateral":
-            params += ", unilateral contact"
-        rows.append((v.id, v.model, f"{v.y:.3f}", v.direction, speed, fmt_g(v.entry_time), params))
-    heads = ("id", "model", "y [m]", "dir", "speed [m/s]", "entry [s]", "parameters")
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(heads[:-1])]
-    fmt = "  " + "  ".join(f"{{:<{w}}}" for w in widths) + "  {}"
-    return [f"Vehicles ({len(rows)})", fmt.format(*heads), *(fmt.format(*r) for r in rows)]
-
-
-def _road_line(scenario: Scenario) -> str:
-    road = scenario.road
-    wheel = scenario.wheel_paths()
-    paths = "y = " + ", ".join(f"{y:g}" for y in wheel) + " m"
-    if scenario.traffic is not None or len(wheel) > 6:
-        paths = f"{len(wheel)} paths, y = {wheel[0]:g} to {wheel[-1]:g} m, each wheel on the nearest"
-    if road.random:
-        return (f"Road: ISO 8608 class {road.road_class}, seed {road.seed}, one profile per wheel path "
-                f"({paths}), x = -10 m to L + 10 m")
-    if road.profile is not None:
-        return f"Road: profile {scenario.road_profile_path} (x, r), on every wheel path"
-    return "Road: smooth"
-
-
-def _solver_line(scenario: Scenario, duration: float) -> str:
-    solver = scenario.solver
-    scheme = solver.scheme if solver.scheme != "hht" else f"hht (alpha = {fmt_g(solver.hht_alpha or 0.0)})"
-    basis = solver.basis
-    if solver.basis == "modal":
-        if solver.modes is not None:
-            basis += f" ({solver.modes} modes)"
-        else:
-            basis += f" (modes below {fmt_g(solver.cutoff_hz or 0.0)} Hz)"
-    if solver.duration is not None:
-        how = "given"
-    elif scenario.traffic is not None:
-        how = "[traffic] end - begin"
-    elif not scenario.vehicles:
-        how = "the replayed log's"
-    else:
-        how = f"last vehicle leaves the deck at {fmt_g(scenario.leave_time or 0.0, 4)} s, + 2 s"
-    steps = int(round(duration / solver.dt))
-    return (f"Solver: {scheme}, {basis} basis, dt = {fmt_g(solver.dt)} s, duration {fmt_g(duration, 4)} s ({how}), "
-            f"{steps} steps, g = {fmt_g(solver.gravity)} m/s^2")
-
-
-def _logging_line(scenario: Scenario, log_path: Path) -> str:
-    every = scenario.output_every
-    steps = "every step" if every == 1 else f"every {every} steps"
-    return f"Log: {log_path}, sampled at {fmt_g(scenario.output_rate_hz, 4)} Hz ({steps})"
-
-
-def _sensor_summary(scenario: Scenario, result) -> list[str]:  # noqa: ANN001 - SimulationResult
-    if not scenario.sensors:
-        return ["Sensors: none (the scenario has no [[sensors]]; the log has only the time of each sample)"]
-    names = [s.name for s in scenario.sensors]
-    width = max(len("name"), *(len(n) for n in names))
-    lines = [
-        "Sensors: peaks over the run (every step)",
-        f"  {'name':<{width}}  {'quantity':<14}{'x [m]':>8}{'y [m]':>8}{'min':>12}{'max':>12}  unit",
-    ]
-    for s in scenario.sensors:
-        unit, factor = display_unit(s.quantity)
-        lo = min(result.sensor_min.get(s.name, 0.0), 0.0) * factor  # t = 0: at rest
-        hi = max(result.sensor_max.get(s.name, 0.0), 0.0) * factor
-        lines.append(f"  {s.name:<{width}}  {s.quantity:<14}{s.x:8.3f}{s.y:8.3f}"
-                     f"{lo + 0.0:12.4g}{hi + 0.0:12.4g}  {unit}")
-    return lines
-
-
-def _fatigue_summary(outcome: RunOutcome) -> list[str]:
-    """Rainflow and Miner damage of the stress sensors with an S-N curve (none: no lines)."""
-    if not outcome.fatigue:
-        return []
-    width = max(len("name"), *(len(n) for n in outcome.fatigue))
-    curve_width = max(len("S-N curve"), *(len(r.curve.name) for r in outcome.fatigue.values()))
-    lines = ["Fatigue: rainflow count of the logged samples, Miner damage; per year: the run's traffic all year",
-             f"  {'name':<{width}}  {'S-N curve':<{curve_width}}{'cycles':>10}{'damage':>12}{'per year':>12}"
-             f"{'eq. range':>11}{'max range':>11}  unit"]
-    for name, r in outcome.fatigue.items():
-        per_year = r.damage_per_year if r.damage_per_year is not None else float("nan")
-        lines.append(f"  {name:<{width}}  {r.curve.name:<{curve_width}}{r.cycles:10.4g}{r.damage:12.4g}"
-                     f"{per_year:12.4g}{r.equivalent_stress_range * 1e-6:11.4g}{r.max_stress_range * 1e-6:11.4g}  MPa")
-    return lines
-
-
-def _vehicle_summary(outcome: RunOutcome, limit: int = 12) -> list[str]:
-    result = outcome.result
-    scripted = [v.id for v in outcome.scenario.vehicles]
-    # A scripted vehicle with several axles is reported axle by axle ("truck#0", "truck#1", ...).
-    contacts = [c for vid in scripted for c in (sorted(c for c in outcome.on_deck if vehicle_of(c) == vid
-                                                       and c != vid) or [vid])]
-    ids = contacts or sorted(outcome.on_deck, key=lambda v: -result.contact_force_range.get(v, (0, 0))[1])
-    lifted_total = sum(1 for v in outcome.on_deck if result.contact_force_range.get(v, (0.0, 0.0))[0] < 0)
-    of = f" of {len(scripted)}" if scripted else ""
-    vehicles = {vehicle_of(c) for c in outcome.on_deck}
-    axles = "" if len(vehicles) == len(outcome.on_deck) else f" ({len(outcome.on_deck)} axles)"
-    lines = [
-        f"Vehicles: {len(vehicles)}{of}{axles} on the deck during the run, at most {result.max_on_deck} "
-        f"at once, {lifted_total} lifted off; contact force, compression positive"
-        + ("" if scripted or len(ids) <= limit else f" (the {limit} heaviest shown)"),
-    ]
-    if not ids:
-        return lines
-    shown = ids if scripted else ids[:limit]
-    width = max(len("id"), *(len(i) for i in shown))
-    lines.append(f"  {'id':<{width}}  {'on the deck [s]':<18}{'min [kN]':>10}{'max [kN]':>10}  lifted off")
-    for vid in shown:
-        if vid not in outcome.on_deck:
-            lines.append(f"  {vid:<{width}}  not on the deck during the run")
-            continue
-        first, last = outcome.on_deck[vid]
-        lo, hi = result.contact_force_range.get(vid, (0.0, 0.0))
-        on_deck = f"{first:.3f} - {last:.3f}"
-        lifted = "yes" if lo < 0 else "no"
-        lines.append(f"  {vid:<{width}}  {on_deck:<18}{lo / 1e3:10.3f}{hi / 1e3:10.3f}  {lifted}")
-    return lines
-
-
-def _run_lines(outcome: RunOutcome) -> list[str]:
-    result, duration = outcome.result, outcome.duration
-    events, steps = result.liftoff_events, result.liftoff_steps
-    lines = [f"Lift-off events: {events} ({steps} vehicle-steps with a negative contact force)"]
-    if events:
-        lines.append("  the contact is kept (bilateral) through a lift-off, as in the paper: "
-                     "results after it assume the wheel stays on the deck")
-    if result.offdeck_events:
-        lines.append(f"Off the deck: {result.offdeck_events} times a wheel went beside the deck's surface over its "
-                     f"length ({result.offdeck_steps} wheel-steps); it loaded nothing there (\"offdeck\" events in "
-                     "the log name each): widen the section's deck if those lanes are on the bridge")
-    wall = result.wall_time
-    factor = f"{duration / wall:.3g}" if wall > 0 else "inf"
-    lines.append(f"Time stepping: {result.steps} steps in {wall:.2f} s wall time; "
-                 f"real-time factor {factor} (simulated time / wall time)")
-    basis = result.info.get("basis", "?")
-    lines.append(f"Effective-matrix factorisations: {result.factorizations} "
-                 f"({basis} basis, {result.info.get('n_reduced', '?')} unknowns)")
-    lines.append(f"Wall time with logging: {outcome.wall_time:.2f} s")
-    return lines
-
-
-def _log_done_line(outcome: RunOutcome) -> str:
-    return (f"Wrote the log {outcome.log_path} ({size_text(outcome.log_bytes)}; {outcome.samples} sensor samples "
-            f"at {fmt_g(outcome.rate_hz, 4)} Hz from t = 0; status finished)")
-
-
-def _header_lines(scenario: Scenario, bridge: BridgeModel, log_path: Path, duration: float | None = None,
-                  plan: SumoPlan | None = None) -> list[str]:
-    spans = " + ".join(f"{span:g}" for span in bridge.spans)
-    replayed = not scenario.vehicles and scenario.traffic is None
-    return [
-        f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
-        *damping_lines(bridge),
-        *(["Traffic: the replayed log's SUMO frames"] if replayed else _vehicle_lines(scenario, plan)),
-        _road_line(scenario),
-        _solver_line(scenario, duration if duration is not None else scenario.duration),
-        _logging_line(scenario, log_path),
-    ]
-
-
-def _simulate_logged(scenario: Scenario, bridge: BridgeModel, log_path: Path, args: argparse.Namespace,
-                     **extra: Any) -> tuple[int, RunOutcome | None]:
-    """The time simulation into ``log_path``: (exit status, outcome) with the failure messages printed."""
-    duration = extra.get("duration") or scenario.duration
-    sys.stdout.flush()
-    progress = Progress(duration, show=not args.quiet)
-    try:
-        outcome = run_logged(scenario, log_path, force=args.force, bridge=bridge, progress=progress, **extra)
-    except RunFailed as exc:
-        progress.close()
-        report_error(f"{exc} (the run failed; its log {exc.log_path} is finished, status \"error\")")
-        return EXIT_RUN_FAILED, None
-    except RunInterrupted as exc:
-        progress.close()
-        where = (f"the log up to there is in {exc.log_path} (finished, status \"interrupted\")"
-                 if exc.log_path is not None else "the run had not started: no log was written")
-        try:
-            print(f"cosim: interrupted by {exc.name} at about t = {progress.fraction * duration:.4g} s of "
-                  f"{duration:g} s; {where}", file=sys.stderr)
-        except (OSError, ValueError):  # SIGHUP: the terminal may be gone
-            pass
-        return 128 + exc.signum, None
-    finally:
-        progress.close()
-    return 0, outcome
-
-
-def _print_outcome(scenario: Scenario, outcome: RunOutcome) -> None:
-    """The end-of-run summary: sensor peaks, vehicles, counters, the log written."""
-    print()
-    print_lines(_sensor_summary(scenario, outcome.result))
-    print_lines(_fatigue_summary(outcome))
-    print_lines(_vehicle_summary(outcome))
-    print_lines(_run_lines(outcome))
-    print(_log_done_line(outcome))
-
-
-def _run_vehicles(scenario: Scenario, args: argparse.Namespace) -> int:
-    """With [[vehicles]]: the time simulation into an MCAP log, an optional sensor CSV and a summary."""
-    default = scenario.log_path or unique_path(scenario.default_log_path())
-    log_path = _log_target(args.out, default, args.force)
-    csv_path = Path(args.csv) if args.csv is not None else scenario.csv_path
-    inputs = scenario_files(scenario)
-    check_not_input(log_path, "log", inputs)
-    if csv_path is not None:
-        check_not_input(csv_path, "sensor CSV", [*inputs, ("the run's log (--out)", log_path)])
-        check_new_file(csv_path, "sensor CSV", args.force)
-    # SUMO: the network and demand are read (and a wrong edge or vType reported) before anything is written.
-    plan = plan_sumo(scenario) if scenario.traffic is not None else None
-    print(scenario_line(scenario))
-    bridge = scenario.build_bridge()
-    print_lines(_header_lines(scenario, bridge, log_path, plan=plan))
-    status, outcome = _simulate_logged(scenario, bridge, log_path, args)
-    if outcome is None:
-        return status
-    _print_outcome(scenario, outcome)
-    if csv_path is not None:
-        rows, columns = export_csv(log_path, csv_path, force=args.force)
-        print(f"Wrote {rows} rows to {csv_path} (columns {','.join(columns)}; SI units: m, m/s, m/s^2, N m)")
-    return 0
-
-
-def cmd_replay(args: argparse.Namespace) -> int:
-    """Re-drive the log's bridge (or ``--scenario``'s) with its traffic, logged; compare the sensors."""
-    other = load_scenario(args.scenario) if args.scenario is not None else None
-    log = Path(args.log)
-    with tempfile.TemporaryDirectory(prefix="cosim-replay-") as scratch:
-        plan = replay_scenario(log, Path(scratch), other)
-        scenario = plan.scenario
-        default = unique_path(scenario.default_log_path(suffix="-replay"))
-        log_path = _log_target(args.out, default, args.force)
-        check_not_input(log_path, "replay's log", [("the log it replays", log),
-                                                   *(scenario_files(other) if other is not None else [])])
-        status_word = plan.overview.status_word
-        if plan.traffic is not None:
-            what = f"its SUMO traffic ({plan.record.get('traffic', 'logged frames')}; SUMO is not run again)"
-        else:
-            ids = ", ".join(v.id for v in scenario.vehicles)
-            what = f"its {len(scenario.vehicles)} scripted vehicle(s) {ids}"
-        print(f"Replay of {log} ({plan.record['log_scenario']}, {status_word}): {what}")
-        if plan.own:
-            print(f"Bridge, sensors, road and solver: the log's own scenario ({scenario.title})")
-        else:
-            print(f"Bridge, sensors, road and solver: {other.source if other else ''} ({scenario.title})")
-        bridge = scenario.build_bridge()
-        print_lines(_header_lines(scenario, bridge, log_path, plan.duration))
-        try:
-            status, outcome = _simulate_logged(scenario, bridge, log_path, args, replay=plan.record,
-                                               attachments=plan.attachments, traffic=plan.traffic,
-                                               duration=plan.duration)
-        finally:
-            if plan.traffic is not None:
-                plan.traffic.close()
-    if outcome is None:
-        return status
-    _print_outcome(scenario, outcome)
-    comparison = compare_sensors(log, log_path)
-    print()
-    if plan.own:
-        return _print_reproduction(comparison, log)
-    print_lines(_comparison_lines(comparison, log, log_path, scenario))
-    return 0
-
-
-def _print_reproduction(comparison: Comparison, log: Path) -> int:
-    n = len(comparison.names)
-    part = ""
-    if comparison.samples_a != comparison.samples_b:  # e.g. the log was interrupted: compare what it holds
-        part = f"; the log holds {comparison.samples_a}, the replay {comparison.samples_b}"
-    if comparison.identical:
-        print(f"Compared with {log}: the {n} sensor channel(s) are identical, bit for bit "
-              f"({comparison.compared} samples{part})")
-        return 0
-    worst = ", ".join(f"{k} {v:.3g}" for k, v in comparison.max_abs_diff.items())
-    print(f"Compared with {log}: the sensor channels DIFFER (largest |difference|, SI units: {worst}; "
-          f"{comparison.compared} samples compared)")
-    return EXIT_RUN_FAILED
-
-
-def _comparison_lines(comparison: Comparison, log: Path, new: Path, scenario: Scenario) -> list[str]:
-    quantities = {s.name: s.quantity for s in scenario.sensors}
-    if not comparison.names:
-        return [f"Compared with {log}: no sensor of the same name in both logs"]
-    width = max(len("name"), *(len(n) for n in comparison.names))
-    lines = [f"Sensors of the same name, the logged run vs this bridge ({new}):",
-             f"  {'name':<{width}}{'log min':>12}{'log max':>12}{'new min':>12}{'new max':>12}  unit"]
-    for name in comparison.names:
-        unit, factor = display_unit(quantities.get(name, ""))
-        (a0, a1), (b0, b1) = comparison.extremes_a[name], comparison.extremes_b[name]
-        lines.append(f"  {name:<{width}}{a0 * factor:12.4g}{a1 * factor:12.4g}{b0 * factor:12.4g}"
-                     f"{b1 * factor:12.4g}  {unit}")
     return lines

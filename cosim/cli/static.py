@@ -3,22 +3,59 @@ from __future__ import annotations
 
 import argparse
 import json
+import textwrap
 from typing import Any
 
-from cosim.core.bridge import PointLoad
-from cosim.run.payloads import jsonable
-from cosim.run.scenario import load_scenario
-from cosim.run.static import STATIC_UNITS, static_response
-
+from .options import FORMATTER, DashValue, Subcommands, bundled_text, finite_float
 from .text import print_lines, scenario_line
+
+NAME = "static"
+#: ``--load X Y FZ``: "-1e5" is a value (:func:`cosim.cli.options.dash_values_kept`).
+DASH_VALUES = {"--load": DashValue(nargs=3)}
+
+
+def add_parser(commands: Subcommands) -> None:
+    """``cosim static``: its arguments and help."""
+    static = commands.add_parser(
+        "static",
+        help="static deck displacements under point loads anywhere on the deck",
+        description=textwrap.dedent(
+            """\
+            Build the scenario's bridge, load it with the given vertical point loads acting
+            together (consistent nodal loads, a static solve) and print the deck
+            displacement under each load and at every sensor's point (mm, positive up),
+            with the bending moment at bending-moment sensors. A load off the deck is an
+            error (exit status 2). Vehicles and traffic of the scenario are ignored."""
+        ),
+        epilog=textwrap.dedent(
+            """\
+            examples:
+              cosim static paper-double-tee --load 20 3.325 -100e3
+              cosim static paper-double-tee --load 20 3.325 -50e3 --load 20 -3.325 -50e3 --json
+            """
+        )
+        + "\n"
+        + bundled_text(),
+        formatter_class=FORMATTER,
+    )
+    static.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml) or bundled scenario name")
+    static.add_argument("--load", nargs=3, type=finite_float, action="append", required=True,
+                        metavar=("X", "Y", "FZ"),
+                        help="a point load: x along the bridge (m), y lateral (m, positive left), Fz (N, positive "
+                             "up: a downward load is negative); repeat for more loads")
+    static.add_argument("--json", action="store_true",
+                        help="print JSON (scenario, theory, loads and sensors with w in m, units) and nothing else")
+    static.set_defaults(func=cmd_static)
 
 
 def cmd_static(args: argparse.Namespace) -> int:
     """Solve the scenario's bridge under the ``--load`` point loads together; print the deck displacements."""
-    scenario = load_scenario(args.scenario)
-    loads = [PointLoad(x=x, y=y, Fz=fz) for x, y, fz in args.load]
-    bridge = scenario.build_bridge()
-    response = static_response(scenario, bridge, loads)
+    from cosim.run.api import static_loads
+    from cosim.run.payloads import jsonable
+    from cosim.run.static import STATIC_UNITS
+
+    done = static_loads(args.scenario, args.load)
+    scenario, bridge, response = done.scenario, done.bridge, done.response
     if args.json:
         payload = {
             "scenario": scenario.title,

@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-from cosim.core.bridge import BridgeModel, ModalResult
-from cosim.core.section import SectionProperties
-from cosim.run.scenario import Scenario
+if TYPE_CHECKING:  # only named here: importing this module must stay cheap (cosim --help imports it)
+    from cosim.core.bridge import BridgeModel, ModalResult
+    from cosim.core.section import SectionProperties
+    from cosim.run.scenario import Scenario
 
 #: Exit statuses: done, the run (or a check) failed, bad input, interrupted (Ctrl-C).
 EXIT_OK = 0
@@ -78,6 +80,17 @@ def print_lines(lines: Sequence[str]) -> None:
 def fmt_g(value: float, digits: int = 6) -> str:
     """``value`` with ``digits`` significant digits (``%g``)."""
     return f"{float(value):.{digits}g}"
+
+
+def window_text(start: float | None, end: float | None) -> str:
+    """`` from t = T0 to T1 s`` for a window of time given on the command line ("" for none)."""
+    if start is None and end is None:
+        return ""
+    low = f"t = {fmt_g(start, 9)}" if start is not None else "the start"
+    high = f"{fmt_g(end, 9)} s" if end is not None else "the end"
+    if start is None:
+        high = f"t = {high}"
+    return f" from {low} to {high}"
 
 
 def size_text(n: int) -> str:

@@ -1,15 +1,17 @@
-"""A log's topics as CSV (``cosim export``, ``cosim run --csv``): SI units, every float in its shortest exact form."""
+"""What is exported from a log: its topics as CSV (``cosim export``, ``cosim run --csv``; SI units, every float
+in its shortest exact form) and the Foxglove layout made for its run (``cosim layout``).
+
+Importing this module loads neither mcap nor numpy (the command line's help lists :data:`EXPORT_TOPICS`).
+"""
 from __future__ import annotations
 
 import csv
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from cosim.core.fields import VEHICLE_FIELDS
 from cosim.errors import CosimError
-from cosim.log.reader import check_window, iter_messages, open_log
-from cosim.log.records import ReadStats
 from cosim.log.schemas import (
     EVENTS_SCHEMA,
     STATUS_SCHEMA,
@@ -20,6 +22,10 @@ from cosim.log.schemas import (
 )
 
 from .outputs import atomic_write, check_new_file, check_not_input
+
+if TYPE_CHECKING:  # the reader loads mcap and numpy: only when a log is read
+    from cosim.log.layout import LayoutInputs
+    from cosim.log.records import ReadStats
 
 #: The topics a log can be exported from.
 EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS)
@@ -55,6 +61,8 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
         LogError: the log cannot be read. CosimError: not an exportable topic, a window that is empty or
             outside the log, or the CSV cannot be written.
     """
+    from cosim.log.reader import check_window, iter_messages, open_log
+
     log, out = Path(log), Path(out)
     check_window(start, end)  # before the log is read
     overview = open_log(log, check="summary", stats=stats)
@@ -86,3 +94,26 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
                 writer.writerow([_cell(msg.get(c)) for c in columns])
                 rows += 1
     return rows, columns
+
+
+def write_layout(log: str | os.PathLike[str], out: str | os.PathLike[str], force: bool = False) -> LayoutInputs:
+    """Write the Foxglove layout of a log's run to ``out`` (a .json file); returns what the layout shows.
+
+    The layout is made from what the log records, as the run attached it (a log written before layouts
+    existed gets one too). ``out`` is never the log, and an existing file is replaced only with ``force``.
+
+    Raises:
+        LogError: the log cannot be read. CosimError: ``out`` is the log, not a .json name, or exists.
+    """
+    from cosim.log.layout import inputs_from_log, layout_bytes, make_layout
+    from cosim.log.reader import open_log
+
+    log, out = Path(log), Path(out)
+    check_not_input(out, "layout", [("the log", log)])
+    if out.suffix.lower() != ".json":
+        raise CosimError(f"{out}: a Foxglove layout is a JSON file: expected a name ending in .json")
+    inputs = inputs_from_log(open_log(log))
+    check_new_file(out, "layout", force)
+    with atomic_write(out, "layout") as partial:
+        partial.write_bytes(layout_bytes(make_layout(inputs)))
+    return inputs

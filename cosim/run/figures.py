@@ -1,7 +1,8 @@
 """Figures of runs and bridges: the values to draw, taken from a log or a model, handed to :mod:`cosim.plots`.
 
 - :func:`plot_log_sensors`: a log's sensor time histories, whole or in a window of time (``cosim plot``);
-- :func:`plot_modes`: a bridge's mode shapes (``cosim modes --plot``).
+- :func:`plot_modes`: a bridge's mode shapes (``cosim modes --plot``);
+- :func:`plot_bridge_location`: the SUMO network around a bridge (``cosim bridge --plot``).
 
 The output file is checked before the work; :mod:`cosim.plots` draws.
 """
@@ -10,6 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -23,10 +25,15 @@ from cosim.log.schemas import TOPIC_SENSORS
 from .outputs import atomic_write, check_new_file, check_not_input
 from .units import display_unit
 
+if TYPE_CHECKING:
+    from cosim.sumo.network import BridgeLocation
+
 #: Points along the bridge at which mode shapes are drawn.
 MODE_SHAPE_POINTS = 401
 #: Samples per sensor a plot draws as they are; a longer log is drawn as its min/max envelope of as many points.
 MAX_PLOT_POINTS = 20_000
+#: The figure of a bridge in its network shows the network this far beyond the deck's ends, m.
+BRIDGE_MARGIN = 60.0
 #: Samples read before they are added to an envelope at once (numpy's ufunc.at per batch, not per sample).
 _BATCH = 8192
 
@@ -177,3 +184,27 @@ def plot_modes(bridge: BridgeModel, modal: ModalResult, path: str | os.PathLike[
     half_width = max(abs(bridge.section.deck_y[0]), abs(bridge.section.deck_y[1]), 1.0)
     with atomic_write(path, "plot") as partial:
         return plots.mode_shapes(x, shapes, titles, supports_x, half_width, partial)
+
+
+def plot_bridge_location(loc: BridgeLocation, path: str | Path, margin: float = BRIDGE_MARGIN) -> None:
+    """Draw the SUMO network around a located bridge into ``path`` (``cosim bridge --plot``): the lanes, the
+    junctions, the deck's lanes, the carriageway's outline and the axis, ``margin`` m beyond the deck's ends."""
+    from cosim.sumo.network import lane_shapes
+
+    axis = loc.axis
+    middle = tuple(0.5 * (np.asarray(axis.start) + np.asarray(axis.end)))
+    half = 0.5 * axis.length + margin
+    shapes = lane_shapes(loc.net, (float(middle[0]), float(middle[1])), half)
+    deck_ids = set(loc.deck_lanes)
+    e, n = axis.unit()
+    lo, hi = loc.carriageway
+    s = np.asarray(axis.start, dtype=float)
+    corners = [s + lo * n, s + axis.length * e + lo * n, s + axis.length * e + hi * n, s + hi * n, s + lo * n]
+    plots.network_figure(
+        lanes=[pts for lid, pts in shapes if lid not in deck_ids and not lid.startswith(":")],
+        junction_lanes=[pts for lid, pts in shapes if lid.startswith(":")],
+        deck_lanes=[pts for lid, pts in shapes if lid in deck_ids],
+        outline=np.array(corners), axis=np.array([axis.start, axis.end]),
+        title=f"edges {', '.join(loc.edges)} of {loc.net.name}: {axis.length:.2f} m", path=path,
+        extent=(middle[0] - half, middle[0] + half, middle[1] - half, middle[1] + half),
+    )

@@ -1,5 +1,8 @@
 """Replays: a bridge re-driven with the traffic recorded in a log, and two logs' sensors compared.
 
+- :func:`replay_log`: a replay as one call (``cosim replay``): the replay's
+  scenario, its logged run and the comparison of its sensors with the log's
+  (:class:`ReplayOutcome`).
 - :func:`replay_scenario`: the scenario that re-drives a bridge with a log's
   traffic, either the log's own (bit-identical sensor channels) or another
   scenario's bridge, sensors, road and solver; run it with
@@ -14,6 +17,8 @@ import math
 import os
 import re
 import sys
+import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
@@ -24,9 +29,12 @@ from cosim.log.replay_source import LoggedTraffic
 from cosim.log.schemas import SCENARIO_ATTACHMENT, TOPIC_SENSORS, TOPIC_TRAFFIC
 from cosim.sumo.files import FILE_OPTIONS, read_config
 
+from .api import RunStart, log_target
 from .config_base import load_config
-from .inputs import input_files
-from .scenario import Scenario, parse_scenario
+from .inputs import input_files, scenario_files
+from .logged import RunOutcome, run_logged
+from .outputs import check_not_input, unique_path
+from .scenario import Scenario, load_scenario, parse_scenario
 from .toml_writer import get_key, set_key, toml_dumps
 
 if sys.version_info >= (3, 11):
@@ -319,3 +327,85 @@ def compare_sensors(log_a: str | os.PathLike[str], log_b: str | os.PathLike[str]
 
     return Comparison(names, counts[0], counts[1], compared, identical and compared > 0 and bool(names), diff,
                       fixed(extremes[0]), fixed(extremes[1]))
+
+
+@dataclass(frozen=True)
+class ReplayOutcome:
+    """A finished replay: what was replayed, the replay's run and its sensors against the log's.
+
+    Attributes:
+        log: the log replayed.
+        plan: the replay's scenario and what is recorded about it (:func:`replay_scenario`).
+        start: the replay's run as it started (its bridge, log and duration).
+        outcome: the replay's finished run (its log is ``outcome.log_path``).
+        comparison: the sensors of the log against the replay's (:func:`compare_sensors`).
+    """
+
+    log: Path
+    plan: ReplayPlan
+    start: RunStart
+    outcome: RunOutcome
+    comparison: Comparison
+
+    @property
+    def own(self) -> bool:
+        """Whether the log's own scenario ran again (its sensor channels must then be identical)."""
+        return self.plan.own
+
+
+def replay_log(
+    log: str | os.PathLike[str],
+    scenario: str | os.PathLike[str] | Scenario | None = None,
+    *,
+    out: str | os.PathLike[str] | None = None,
+    force: bool = False,
+    checked: Callable[[ReplayPlan], None] | None = None,
+    ready: Callable[[RunStart], None] | None = None,
+    progress: Callable[[float], None] | None = None,
+) -> ReplayOutcome:
+    """Re-drive a bridge with the traffic of ``log`` into a new log, and compare its sensors with the log's.
+
+    Without ``scenario`` the log's own scenario runs again (its sensor channels should come out identical,
+    bit for bit); with one, that scenario's bridge, sensors, road and solver take the log's traffic
+    (:func:`replay_scenario`). The replay's log goes to ``out``, else
+    ``runs/<scenario name>-replay-<YYYYmmdd-HHMMSS>.mcap``; the input files the replay needs are written
+    into a scratch folder that is removed afterwards.
+
+    Args:
+        log: the log to replay.
+        scenario: the scenario (or its file or bundled name) whose bridge to drive, or None for the log's own.
+        out: the replay's log (.mcap).
+        force: overwrite ``out`` if it exists.
+        checked: called with the replay's plan once the log, the scenario and ``out`` are checked, before the
+            bridge is built.
+        ready: called when the bridge is built, just before the time stepping.
+        progress: called with the fraction done after every block of time steps.
+
+    Raises:
+        LogError, ConfigError, CosimError: a log that cannot be replayed, traffic that does not fit the bridge,
+            an output that may not be written (before anything is written).
+        RunInterrupted, RunFailed: as :func:`cosim.run.logged.run_logged`.
+    """
+    other = scenario if scenario is None or isinstance(scenario, Scenario) else load_scenario(scenario)
+    log = Path(log)
+    with tempfile.TemporaryDirectory(prefix="cosim-replay-") as scratch:
+        plan = replay_scenario(log, Path(scratch), other)
+        try:
+            replayed = plan.scenario
+            log_path = log_target(out, unique_path(replayed.default_log_path(suffix="-replay")), force)
+            check_not_input(log_path, "replay's log", [("the log it replays", log),
+                                                       *(scenario_files(other) if other is not None else [])])
+            if checked is not None:
+                checked(plan)
+            bridge = replayed.build_bridge()
+            duration = plan.duration if plan.duration is not None else replayed.duration
+            start = RunStart(replayed, bridge, log_path, duration)
+            if ready is not None:
+                ready(start)
+            outcome = run_logged(replayed, log_path, force=force, bridge=bridge, progress=progress,
+                                 replay=plan.record, attachments=plan.attachments, traffic=plan.traffic,
+                                 duration=plan.duration)
+        finally:
+            if plan.traffic is not None:
+                plan.traffic.close()
+    return ReplayOutcome(log, plan, start, outcome, compare_sensors(log, log_path))

@@ -39,7 +39,6 @@ import math
 import os
 import re
 from collections.abc import Iterator
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -75,6 +74,7 @@ from .bridge_tables import (
     PlateConfig,
     SectionConfig,
 )
+from .bundled import bundled_folder, list_bundled_scenarios
 from .config_base import (
     ConfigModel,
     Problems,
@@ -514,18 +514,6 @@ class Scenario(ConfigModel):
 
 # --------------------------------------------------------------------------- loading
 
-_BUNDLED_PACKAGE = "cosim"
-_BUNDLED_DIR = "scenarios"
-
-
-def list_bundled_scenarios() -> list[str]:
-    """Names of the scenarios shipped with cosim (usable wherever a scenario path is)."""
-    folder = resources.files(_BUNDLED_PACKAGE).joinpath(_BUNDLED_DIR)
-    if not folder.is_dir():
-        return []
-    return sorted(item.name[: -len(".toml")] for item in folder.iterdir() if item.name.endswith(".toml"))
-
-
 def parse_scenario(
     text: str, source: str = "<scenario>", base_dir: str | os.PathLike[str] = "."
 ) -> Scenario:
@@ -567,7 +555,7 @@ def load_scenario(path_or_name: str | os.PathLike[str]) -> Scenario:
         return parse_scenario(text, source, base_dir=path.parent)
     bundled = list_bundled_scenarios()
     if source in bundled:
-        folder = resources.files(_BUNDLED_PACKAGE).joinpath(_BUNDLED_DIR)
+        folder = bundled_folder()
         resource = folder.joinpath(f"{source}.toml")
         return parse_scenario(resource.read_text(encoding="utf-8"), source, base_dir=str(folder))
     if path.is_dir():

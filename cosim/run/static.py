@@ -6,17 +6,22 @@ and at every sensor. :func:`static_cases` is ``cosim run``'s fixed case on the
 same code: a :data:`STATIC_LOAD_N` downward point load at mid-span of the
 longest span, once on the bridge axis (y = 0) and once at the left deck edge
 (largest y).
+
+Importing this module loads neither numpy nor the scenario machinery (the
+command line's help quotes :data:`STATIC_LOAD_N`).
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from cosim.core.bridge import BridgeModel, PointLoad
 from cosim.errors import ConfigError
 
-from .scenario import Scenario
+if TYPE_CHECKING:  # the bridge and the scenario load numpy, scipy and pydantic: only when solving
+    from cosim.core.bridge import BridgeModel, PointLoad
+
+    from .scenario import Scenario
 
 #: The static load of ``cosim run`` without vehicles, N (downward).
 STATIC_LOAD_N = 100e3
@@ -61,6 +66,8 @@ def static_response(scenario: Scenario, bridge: BridgeModel, loads: Sequence[Poi
     Raises:
         ConfigError: a load is not finite or lies off the deck (:func:`check_loads`).
     """
+    from cosim.core.bridge import PointLoad
+
     check_loads(bridge, loads)
     on_deck = [PointLoad(min(max(p.x, 0.0), bridge.length), p.y, p.Fz) for p in loads]
     result = bridge.static(on_deck)
@@ -80,6 +87,8 @@ def static_response(scenario: Scenario, bridge: BridgeModel, loads: Sequence[Poi
 def static_cases(scenario: Scenario, bridge: BridgeModel) -> list[dict[str, Any]]:
     """The load on the axis ("axis") and at the left edge ("left_edge"): per case the load (x, y, Fz, span),
     the deck displacement under it (``w_load_point``, m, positive up) and at each sensor (``sensors``)."""
+    from cosim.core.bridge import PointLoad
+
     spans = scenario.bridge.spans
     longest = max(range(len(spans)), key=lambda i: spans[i])
     x_load = sum(spans[:longest]) + 0.5 * spans[longest]

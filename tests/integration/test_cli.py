@@ -3,6 +3,8 @@ and ``python -m cosim`` as a real process."""
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -24,7 +26,7 @@ def _without_vehicles(text: str) -> str:
 PAPER_STATIC_TEXT = _without_vehicles(PAPER_TEXT)
 
 
-from _cli import cosim_cli, cosim_process  # noqa: E402
+from _cli import cli_env, cosim_cli, cosim_process  # noqa: E402
 
 # --------------------------------------------------------------------------- help
 
@@ -47,6 +49,45 @@ def test_help_exits_zero_and_describes_options(args: tuple[str, ...], mentions: 
     assert result.returncode == 0, result.stderr
     for word in mentions:
         assert word in result.stdout, word
+
+
+#: What the help of cosim and of its commands must not load: each command imports them when it runs.
+HEAVY = ("numpy", "scipy", "numba", "matplotlib", "mcap", "sumolib", "libsumo", "traci", "pydantic", "pandas",
+         "dask", "distributed", "sectionproperties", "shapely", "tqdm")
+
+
+@pytest.mark.parametrize("command", ["", "modes", "static", "run", "replay", "export", "info", "plot", "layout",
+                                     "validate", "study", "dataset", "bridge"], ids=lambda c: c or "cosim")
+def test_help_loads_no_heavy_library(command: str) -> None:
+    """``cosim --help`` and ``cosim <command> --help`` build the whole parser and print, loading none of the
+    libraries the commands work with (a fresh process: what a user's ``cosim ... --help`` loads)."""
+    code = ("import sys\nfrom cosim.cli import main\n"
+            "status = main([*sys.argv[1:], '--help'])\n"
+            f"loaded = sorted({{name.split('.')[0] for name in sys.modules}} & set({HEAVY!r}))\n"
+            "print('loaded:', loaded, 'status:', status)\n")
+    args = [command] if command else []
+    result = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=REPO,
+                            env=cli_env(), timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[-1] == "loaded: [] status: 0", result.stdout.splitlines()[-1]
+    assert (f"usage: cosim {command}" if command else "usage: cosim [-h]") in result.stdout
+
+
+@pytest.mark.parametrize(("argv", "expected"), [
+    (["export", "x.mcap", "--csv", "o.csv", "--from", "-1e5", "--to", "-5."], {"start": -1e5, "end": -5.0}),
+    (["plot", "x.mcap", "-o", "f.png", "--fro", "-1e3", "--to", "-.5"], {"start": -1e3, "end": -0.5}),
+    (["static", "s", "--load", "20", "3.325", "-100e3", "--load", "-1", "-2.5", "-3E3"],
+     {"load": [[20.0, 3.325, -1e5], [-1.0, -2.5, -3e3]]}),
+    (["bridge", "n.net.xml", "--edge", "-123#0", "--edge", "5", "--near", "-5", "3"],
+     {"edge": ["-123#0", "5"], "near": [-5.0, 3.0]}),
+], ids=["export", "plot-abbreviated", "static", "bridge"])
+def test_values_that_begin_with_a_dash_are_values(argv: list[str], expected: dict) -> None:
+    """A negative number after an option that takes numbers ("-1e5": an option to argparse before Python 3.13)
+    and a SUMO edge id beginning with "-" are that option's values."""
+    from cosim.cli.app import build_parser, values_kept
+
+    args = vars(build_parser().parse_args(values_kept(argv)))
+    assert {key: args[key] for key in expected} == expected
 
 
 def test_python_m_cosim_is_the_command_line_with_its_exit_statuses(tmp_path: Path) -> None:

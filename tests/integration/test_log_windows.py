@@ -360,7 +360,7 @@ def test_info_lists_the_sumo_vehicles_of_a_long_log_from_its_start_unless_verify
                                                                                  ) -> None:
     """The vehicles come from the "entered" events: all of them with --verify, those of the first
     ``EVENT_CHUNKS`` chunks without (lowered here so that 2 min of SUMO traffic count as long)."""
-    from cosim.cli import logs
+    from cosim.run import loginfo
     from cosim.run.scenario import load_scenario
 
     text = load_scenario("paper-bridge-traffic").text.replace("end = 600.0 ", "end = 120.0 ", 1)
@@ -372,7 +372,7 @@ def test_info_lists_the_sumo_vehicles_of_a_long_log_from_its_start_unless_verify
     whole = next(line for line in full.splitlines() if line.startswith("Vehicles (SUMO, "))
     assert cosim_cli("info", str(log)).stdout.count(whole) == 1  # a short log: every chunk within the budget
     vehicles = int(whole.split()[2])
-    monkeypatch.setattr(logs, "EVENT_CHUNKS", 3)
+    monkeypatch.setattr(loginfo, "EVENT_CHUNKS", 3)
     fast = cosim_cli("info", str(log)).stdout
     start = next(line for line in fast.splitlines() if line.startswith("Vehicles (SUMO, "))
     assert ", in its first " in start and " s (--verify: the whole log)): " in start, start

@@ -11,7 +11,7 @@ import pytest
 from _cli import TWO_CARS, cosim_cli
 
 from cosim import cli
-from cosim.cli import run as cli_run
+from cosim.cli import summary as cli_summary
 from cosim.errors import ModelError
 from cosim.log import TOPIC_SENSORS, read_log
 from cosim.run import logged as runner
@@ -207,7 +207,7 @@ def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
 
     terminal = Terminal()
     monkeypatch.setattr("sys.stderr", terminal)
-    progress = cli_run.Progress(20.0, show=True)
+    progress = cli_summary.Progress(20.0, show=True)
     progress(0.5)
     progress(1.0)
     progress.close()
@@ -216,7 +216,7 @@ def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
 
     quiet = Terminal()
     monkeypatch.setattr("sys.stderr", quiet)
-    progress = cli_run.Progress(20.0, show=False)
+    progress = cli_summary.Progress(20.0, show=False)
     progress(1.0)
     progress.close()
     assert quiet.getvalue() == ""

@@ -241,10 +241,6 @@ ISOLATED_PRIVATE_READS = {
     ("cosim/core/jit.py", "_locator_classes"),  # numba's cache locators, extended with cosim's
     ("cosim/core/jit.py", "_CacheImpl"),  # numba.core.caching's CacheImpl before numba 0.61
 }
-#: Pending in issue 24 (item 6), to be removed by their owners (and then from here; the lead empties this list).
-PENDING_PRIVATE_READS = ISOLATED_PRIVATE_READS | {
-    ("cosim/cli/app.py", "_negative_number_matcher"),  # argparse's, so that "--from -5" is a value
-}
 
 
 def _own_names(tree: ast.AST) -> set[str]:
@@ -283,7 +279,7 @@ def test_no_module_reads_another_modules_or_packages_private_names():
                 found += [(node.lineno, a.name) for a in node.names]
         for line, name in found:
             private = name.startswith("_") and not name.startswith("__") and not MANGLED.match(name)
-            if private and name not in PUBLIC_UNDERSCORE and (_relative(path), name) not in PENDING_PRIVATE_READS:
+            if private and name not in PUBLIC_UNDERSCORE and (_relative(path), name) not in ISOLATED_PRIVATE_READS:
                 problems.append(f"{_relative(path)}:{line}: {name}")
     assert not problems, "private names of other modules or packages:\n" + "\n".join(problems)
 

@@ -1,48 +1,54 @@
-"""``cosim export``, ``cosim info`` and ``cosim plot``: what is in a log, as CSV, text or a figure."""
+"""``cosim info``: what a log holds, and whether it is whole."""
 from __future__ import annotations
 
 import argparse
 import json
-import sys
+import textwrap
+from typing import TYPE_CHECKING
 
-from cosim.core.traffic import vehicle_of
-from cosim.log.reader import LogOverview, file_is_complete, iter_messages, open_log
-from cosim.log.records import ReadStats
-from cosim.log.schemas import REPLAY_METADATA_NAME, TOPIC_EVENTS, TOPIC_SENSORS, TOPIC_TRAFFIC
-from cosim.run.export import export_csv
-from cosim.run.figures import plot_log_sensors
-from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
+from cosim.log.schemas import REPLAY_METADATA_NAME
 
+from .options import FORMATTER, Subcommands
 from .text import fmt_g, print_lines, size_text
 
+if TYPE_CHECKING:
+    from cosim.log.reader import LogOverview
+    from cosim.run.loginfo import DeckVehicles, LogInfo
 
-def window_text(start: float | None, end: float | None) -> str:
-    """`` from t = T0 to T1 s`` for a window of time given on the command line ("" for none)."""
-    if start is None and end is None:
-        return ""
-    low = f"t = {fmt_g(start, 9)}" if start is not None else "the start"
-    high = f"{fmt_g(end, 9)} s" if end is not None else "the end"
-    if start is None:
-        high = f"t = {high}"
-    return f" from {low} to {high}"
+NAME = "info"
 
 
-def cmd_export(args: argparse.Namespace) -> int:
-    """Write a topic of a log (or of a window of it) as CSV."""
-    rows, columns = export_csv(args.log, args.csv, topic=args.topic, force=args.force, start=args.start,
-                               end=args.end)
-    if not file_is_complete(args.log):
-        print(f"note: {args.log} was cut short (truncated); exported what it holds up to its last complete chunk",
-              file=sys.stderr)
-    units = "SI units: m, m/s, m/s^2, N m" if args.topic == TOPIC_SENSORS else "SI units"
-    print(f"Wrote {rows} rows of {args.topic}{window_text(args.start, args.end)} to {args.csv} "
-          f"(columns {','.join(columns)}; {units})")
-    return 0
+def add_parser(commands: Subcommands) -> None:
+    """``cosim info``: its arguments and help."""
+    info = commands.add_parser(
+        "info",
+        help="summarise a log: scenario, duration, topics, status, truncated or not",
+        description=textwrap.dedent(
+            """\
+            Summarise a log: its scenario, cosim version, simulated time, sensors, topics
+            with message counts, final status and message, whether the file is truncated
+            (cut short by a killed process: exit status 0, the readable part is shown) and
+            its attachments. A finished log is read through its summary (counts, times,
+            chunk index) in seconds however long it is; every byte is checked against the
+            file's checksums, and the chunk holding the final status is decompressed.
+            --verify also decompresses every chunk, verifies its checksum and counts the
+            messages (the summary must agree). A damaged file or one that is not a cosim
+            MCAP log exits with status 2."""
+        ),
+        epilog="examples:\n  cosim info runs/run1.mcap\n  cosim info --verify runs/run1.mcap\n",
+        formatter_class=FORMATTER,
+    )
+    info.add_argument("log", metavar="LOG.mcap", help="a cosim log")
+    info.add_argument("--verify", action="store_true",
+                      help="decompress every chunk and verify every checksum (seconds per 100 MB of log)")
+    info.set_defaults(func=cmd_info)
 
 
 def cmd_info(args: argparse.Namespace) -> int:
     """Summarise a log: from its summary, or (``--verify``) from every chunk."""
-    print_lines(info_lines(open_log(args.log, check="full" if args.verify else "file")))
+    from cosim.run.loginfo import log_info
+
+    print_lines(info_lines(log_info(args.log, verify=args.verify)))
     return 0
 
 
@@ -64,8 +70,9 @@ def checked_line(o: LogOverview, extra_chunks: int = 0) -> str:
             f"decompressed{unread}{older}; counts from the summary (--verify: every chunk)")
 
 
-def info_lines(o: LogOverview) -> list[str]:
+def info_lines(log: LogInfo) -> list[str]:
     """The lines of ``cosim info``."""
+    o = log.overview
     info = o.info
     lines = [f"Log: {o.path} ({size_text(o.size)}, {'finished file' if o.complete else 'TRUNCATED'})"]
     if info:
@@ -90,9 +97,9 @@ def info_lines(o: LogOverview) -> list[str]:
     sensors = ", ".join(f"{n} ({q})" if q else n for n, q in zip(o.sensor_names, o.quantities)) or "none"
     lines.append(f"Sensors ({len(o.sensor_names)}): {sensors}")
     extra_chunks = 0
-    if o.counts.get(TOPIC_TRAFFIC) or info.get("traffic") == "sumo":
-        vehicle_lines, extra_chunks = _sumo_vehicle_lines(o)
-        lines.extend(vehicle_lines)
+    if log.deck is not None:
+        lines.extend(_sumo_vehicle_lines(o, log.deck))
+        extra_chunks = log.deck.chunks
     elif "vehicles" in info:
         try:
             vehicles = json.loads(info["vehicles"])
@@ -122,38 +129,18 @@ def info_lines(o: LogOverview) -> list[str]:
 
 #: SUMO vehicles listed by name in ``cosim info`` (the rest are counted).
 SHOWN_VEHICLES = 20
-#: Chunks ``cosim info`` (without --verify) reads for the SUMO vehicles' events: about 20 min of the default run.
-EVENT_CHUNKS = 256
 
 
-def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
-    """The SUMO vehicles that were on the deck (from the "entered" events) and the vehicle types of the run,
-    and the chunks read for them.
+def _sumo_vehicle_lines(o: LogOverview, deck: DeckVehicles) -> list[str]:
+    """The SUMO vehicles that were on the deck (without ``--verify``: those of the log's start, and the line
+    says so) and the vehicle types of the run."""
+    from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
 
-    Without ``--verify`` the events are read from at most :data:`EVENT_CHUNKS` chunks (a day's log has
-    thousands): the vehicles of a long log are those of its start, and the line says so.
-    """
-    axles: dict[str, int] = {}
-    stats = ReadStats()
-    budget = None if o.check == "full" else EVENT_CHUNKS
-    last_t, cut = 0.0, False
-    if o.counts.get(TOPIC_EVENTS):
-        # A window over the whole log: a finished log's chunks are then read through its index, one at a time.
-        messages = iter_messages(o.path, [TOPIC_EVENTS], start=o.start_time, stats=stats)
-        for _, message in messages:
-            if budget is not None and stats.chunks > budget:
-                cut = True
-                break
-            last_t = float(message["t"])
-            if message.get("event") == "entered":
-                contact = str(message.get("vehicle", ""))
-                axles.setdefault(contact, 0)
-        messages.close()  # type: ignore[attr-defined]
-    vehicles = list(dict.fromkeys(vehicle_of(c) for c in axles))
+    vehicles = deck.vehicles
     shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"
                                                     if len(vehicles) > SHOWN_VEHICLES else "")
-    axle_text = f", {len(axles)} axles" if len(axles) != len(vehicles) else ""
-    when = f", in its first {fmt_g(last_t, 6)} s (--verify: the whole log)" if cut else ""
+    axle_text = f", {deck.axles} axles" if deck.axles != len(vehicles) else ""
+    when = f", in its first {fmt_g(deck.until, 6)} s (--verify: the whole log)" if deck.until is not None else ""
     lines = [f"Vehicles (SUMO, {len(vehicles)} on the deck{axle_text}{when}): {shown or 'none'}"]
     raw = o.attachments.get(VEHICLE_TYPES_ATTACHMENT)
     if raw is not None:
@@ -164,12 +151,4 @@ def _sumo_vehicle_lines(o: LogOverview) -> tuple[list[str], int]:
             lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
-    return lines, stats.chunks
-
-
-def cmd_plot(args: argparse.Namespace) -> int:
-    """Draw a log's sensor time histories (or a window of them)."""
-    drawn = plot_log_sensors(args.log, args.output, args.sensor, force=args.force, start=args.start, end=args.end)
-    print(f"Wrote {len(drawn)} sensor time histor{'y' if len(drawn) == 1 else 'ies'} ({', '.join(drawn)})"
-          f"{window_text(args.start, args.end)} to {args.output}")
-    return 0
+    return lines
