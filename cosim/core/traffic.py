@@ -131,11 +131,12 @@ class TrafficSource(abc.ABC):
 
 
 class FrameSink(Protocol):
-    """Where a live traffic source sends what it produces (a log): every frame with the vehicle models of
-    the types known so far (a mapping that is never changed afterwards), and its documents (the vehicle-type
-    table at the start, the simulator's messages at the end)."""
+    """Where a live traffic source sends what it produces (a log): every frame, with the vehicle models of the
+    types that became known since the frame before (each type once, before any frame names it; the sink keeps
+    what it needs of them), and its documents (the vehicle-type table at the start, the simulator's messages
+    at the end)."""
 
-    def __call__(self, frame: Frame, models: Mapping[str, VehicleModel]) -> None: ...
+    def __call__(self, frame: Frame, new_models: Mapping[str, VehicleModel]) -> None: ...
 
     def attach(self, name: str, data: bytes | str, media_type: str) -> None: ...
 
@@ -389,18 +390,18 @@ class FrameTraffic(TrafficSource):
         """Vehicle types (type -> model) that frames may name from now on."""
         self._models.update(models)
 
-    def add_frame(self, frame: Frame, models: Mapping[str, VehicleModel] | None = None) -> None:
-        """Append the next frame (its time one ``step`` after the last); ``models``: where the models of types
-        it names for the first time are found."""
+    def add_frame(self, frame: Frame, new_models: Mapping[str, VehicleModel] | None = None) -> None:
+        """Append the next frame (its time one ``step`` after the last), and the vehicle types that became known
+        with it (``new_models``: type -> model)."""
         expected = self.frames[-1].t + self.step
         if abs(frame.t - expected) > 1e-6 * self.step:
             raise ConfigError(f"traffic frames must be {self.step} s apart (got t = {frame.t}, expected {expected})")
         own = self._models
+        if new_models:
+            own.update(new_models)
         for typ in frame.types:
             if typ not in own:
-                if models is None or typ not in models:
-                    raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
-                own[typ] = models[typ]
+                raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
         self.frames.append(frame)
 
     @property

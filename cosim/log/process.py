@@ -128,7 +128,6 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
     replies.send(("ready", None))
     logger: BlockLogger | None = None
     sink: TrafficLogger | None = None  # SUMO frames, handed to the logger, which writes them between its pieces
-    models: dict[str, Any] = {}
     error: str | None = None
     while True:
         try:
@@ -153,9 +152,10 @@ def _serve(commands: Connection, replies: Connection, path: Path, names: list[st
             if op == "block":
                 _, times, keep, report, frames, new_models = message
                 assert logger is not None and sink is not None, "blocks before the block logger"
-                models.update(new_models)
+                first = True
                 for frame in unpack_frames(frames):
-                    sink(frame, models)
+                    sink(frame, new_models if first else {})
+                    first = False
                 if times is not None:
                     logger.on_block(times, keep, report)
             elif op == "logger":
@@ -312,7 +312,6 @@ class _BlockStream:
         self.log = log
         self._frames: list[Any] = []
         self._new_models: dict[str, Any] = {}
-        self._known: set[str] = set()
 
     def on_block(self, times, keep, report) -> None:  # noqa: ANN001 - the simulate() observer protocol
         self._hand_over(times, keep, report)
@@ -352,13 +351,10 @@ class _FrameSink:
     def __init__(self, stream: _BlockStream) -> None:
         self.stream = stream
 
-    def __call__(self, frame, models: dict) -> None:  # noqa: ANN001 - the adapter's frame sink protocol
+    def __call__(self, frame, new_models: dict) -> None:  # noqa: ANN001 - the frame sink protocol
         stream = self.stream
         stream._frames.append(frame)
-        for typ in frame.types:
-            if typ not in stream._known:
-                stream._known.add(typ)
-                stream._new_models[typ] = models[typ]
+        stream._new_models.update(new_models)  # handed to the child with the next block, before its frames
 
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
         """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""

@@ -618,18 +618,19 @@ class TrafficLogger:
 
     def __init__(self, recorder: LogRecorder, defer: list[tuple[Any, dict]] | None = None) -> None:
         self.rec = recorder
-        self._types: set[str] = set()
+        self._types: set[str] = set()  # the types whose message is written
+        self._models: dict[str, Any] = {}  # every type announced by the source (its model)
         self._defer = defer  # frames are appended here for a writer thread (BlockLogger.traffic_sink)
 
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
         """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""
         self.rec.attach(name, data, media_type)
 
-    def __call__(self, frame, models: dict) -> None:
+    def __call__(self, frame, new_models: dict) -> None:
         if self._defer is not None:
-            self._defer.append((frame, models))  # frames are immutable; models only gains entries
+            self._defer.append((frame, new_models))  # frames are immutable, and so are the new models handed on
         else:
-            self.write_frame(frame, models)
+            self.write_frame(frame, new_models)
 
     def write_frames(self, frames: list[tuple[Any, dict]]) -> None:
         """Write frames handed over by :meth:`__call__`, in order: encoded together and added in one bulk
@@ -637,26 +638,28 @@ class TrafficLogger:
         still before the first frame that has it."""
         times: list[float] = []
         datas: list[bytes] = []
-        for frame, models in frames:
+        for frame, new_models in frames:
+            if new_models:
+                self._models.update(new_models)
             if any(typ not in self._types for typ in frame.types):
                 self.rec.write_encoded(TOPIC_TRAFFIC, times, datas)
                 times, datas = [], []
-                self._write_types(frame, models)
+                self._write_types(frame)
             if frame.ids:
                 times.append(frame.t)
                 datas.append(self._encode(frame))
         self.rec.write_encoded(TOPIC_TRAFFIC, times, datas)
 
-    def write_frame(self, frame, models: dict) -> None:
+    def write_frame(self, frame, new_models: dict) -> None:
         """Write one frame (and the vehicle types it brings first)."""
-        self.write_frames([(frame, models)])
+        self.write_frames([(frame, new_models)])
 
-    def _write_types(self, frame, models: dict) -> None:
+    def _write_types(self, frame) -> None:  # noqa: ANN001
         for typ in frame.types:
             if typ not in self._types:
                 self._types.add(typ)
                 self.rec.write(TOPIC_VEHICLE_TYPES, frame.t, {"t": frame.t, "type": typ,
-                                                              "model": model_to_dict(models[typ])})
+                                                              "model": model_to_dict(self._models[typ])})
 
     @staticmethod
     def _encode(frame) -> bytes:

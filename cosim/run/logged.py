@@ -256,10 +256,10 @@ class FrameRelay:
         for document in held:
             sink.attach(*document)
 
-    def __call__(self, frame: Frame, models: Mapping[str, VehicleModel]) -> None:
+    def __call__(self, frame: Frame, new_models: Mapping[str, VehicleModel]) -> None:
         if self._sink is None:
             raise LogError("a traffic frame came before the run's log was open")
-        self._sink(frame, models)
+        self._sink(frame, new_models)
 
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
         if self._sink is None:

@@ -30,11 +30,13 @@ from __future__ import annotations
 import collections
 import contextlib
 import multiprocessing
+from collections.abc import Mapping
 from multiprocessing.connection import Connection
 from typing import Any
 
 from cosim import errors
 from cosim.core.traffic import Frame, pack_frames, unpack_frames
+from cosim.core.vehicles import VehicleModel
 from cosim.log.process import fork_child, signals_held
 from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT, LiveSumo, SumoSettings, SumoTraffic
 
@@ -61,7 +63,7 @@ class _Documents:
     def __init__(self) -> None:
         self.documents: dict[str, bytes | str] = {}
 
-    def __call__(self, frame: Frame, models: object) -> None:
+    def __call__(self, frame: Frame, new_models: Mapping[str, VehicleModel]) -> None:
         raise AssertionError("the child steps SUMO with advance(), not through its sink")
 
     def attach(self, name: str, data: bytes | str, media_type: str) -> None:

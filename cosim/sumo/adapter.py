@@ -165,9 +165,10 @@ class LiveSumo(TrafficSource):
     child process (:class:`cosim.run.sumo_process.SumoProcess`) share.
 
     Its frames go, as they come, into the :class:`~cosim.core.traffic.FrameSink` it is built with (a log),
-    with the models of the vehicle types known so far: a mapping that is replaced, never changed, when a type
-    appears. The sink also gets the vehicle-type table when SUMO has started and SUMO's messages when it has
-    closed. The frames feed a :class:`~cosim.core.traffic.FrameTraffic`, which the beam sub-steps through.
+    each with the models of the vehicle types that became known since the frame before (every consumer keeps
+    its own table: none is shared). The sink also gets the vehicle-type table when SUMO has started and
+    SUMO's messages when it has closed. The frames feed a :class:`~cosim.core.traffic.FrameTraffic`, which the
+    beam sub-steps through.
     """
 
     def __init__(self, settings: SumoSettings, frame_sink: FrameSink | None = None) -> None:
@@ -177,7 +178,8 @@ class LiveSumo(TrafficSource):
         self.lanes: tuple[str, ...] = ()
         self.deck_lanes: tuple[str, ...] = ()
         self.reach = WATCH_MARGIN
-        self.models: Mapping[str, VehicleModel] = MappingProxyType({})
+        self._models: dict[str, VehicleModel] = {}  # every type known so far (this source's own table)
+        self._fresh: dict[str, VehicleModel] = {}  # known since the last frame was handed on
         self.types: dict[str, VehicleType] = {}
         self.frames: FrameTraffic | None = None
         self.sumo_steps = 0
@@ -212,10 +214,17 @@ class LiveSumo(TrafficSource):
     def deck_y(self) -> tuple[float, float]:
         return self.settings.deck_y
 
+    @property
+    def models(self) -> Mapping[str, VehicleModel]:
+        """Every vehicle type known so far -> its model (read-only)."""
+        return MappingProxyType(self._models)
+
     def _known(self, models: Mapping[str, VehicleModel]) -> None:
-        """More vehicle types: a new mapping (the one frames were handed with stays as it was)."""
-        if any(k not in self.models for k in models):
-            self.models = MappingProxyType({**self.models, **models})
+        """More vehicle types (those already known are kept as they are)."""
+        for key, model in models.items():
+            if key not in self._models:
+                self._models[key] = model
+                self._fresh[key] = model
 
     def _attach(self, name: str, data: bytes | str, media_type: str) -> None:
         if self.frame_sink is not None:
@@ -230,7 +239,7 @@ class LiveSumo(TrafficSource):
         except BaseException:
             self.close()
             raise
-        self.frames = FrameTraffic(self.step, self.axis.length, self.models)
+        self.frames = FrameTraffic(self.step, self.axis.length)
         return self
 
     def close(self) -> None:
@@ -252,10 +261,10 @@ class LiveSumo(TrafficSource):
             if self.begin + frames.last_time + self.step > self.end + 1e-9:
                 raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
             frame = self._next_frame()
-            models = self.models
-            frames.add_frame(frame, models)
+            fresh, self._fresh = self._fresh, {}
+            frames.add_frame(frame, fresh)
             if self.frame_sink is not None:
-                self.frame_sink(frame, models)
+                self.frame_sink(frame, fresh)
         out = frames.block(times)
         frames.forget_before(float(times[-1]))
         return out

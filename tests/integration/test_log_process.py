@@ -109,6 +109,7 @@ def test_joined_blocks_are_logged_in_pieces_exactly_as_block_by_block(tmp_path: 
     handed over block by block. Real SUMO, real MCAP files: same messages, same bytes, same order."""
     from cosim.core.simulation import simulate
     from cosim.log.writer import BlockLogger, LogRecorder
+    from cosim.run.logged import FrameRelay
     from cosim.run.simulate import build_traffic
 
     scenario = bundled_scenario("paper-bridge-traffic", end=40.0, dt=dt)
@@ -117,9 +118,10 @@ def test_joined_blocks_are_logged_in_pieces_exactly_as_block_by_block(tmp_path: 
     orders = []
     for join in (True, False):
         path = tmp_path / f"join-{join}.mcap"
-        with LogRecorder(path, names) as rec, build_traffic(scenario) as traffic:
+        relay = FrameRelay()  # the frame sink the source is built with, connected once the log is open
+        with LogRecorder(path, names) as rec, build_traffic(scenario, frame_sink=relay) as traffic:
             with BlockLogger(rec, names, 40.0, threaded=False, piece_steps=200 if join else None) as logger:
-                traffic.frame_sink = logger.traffic_sink()
+                relay.connect(logger.traffic_sink())
                 simulate(bridge, traffic, 40.0, scenario.solver_settings(), scenario.sensors_core(),
                          road=scenario.build_road(), output_every=scenario.output_every, observers=[logger],
                          collect=False, join_blocks=join)
