@@ -13,6 +13,7 @@ overhangs").
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 #: Raw units to SI. Weights: BTLS's 1 x 100 kg = 0.981 kN (``KG100_TO_KN``), 1 kg = 9.81e-3 kN.
 HUNDRED_KG = 981.0  # N
@@ -57,13 +58,27 @@ class Format:
     spacing: float
     track: float
 
-    @property
+    @cached_property
     def header_width(self) -> int:
         return sum(width for _, width in self.header)
 
-    @property
+    @cached_property
     def axle_width(self) -> int:
         return sum(width for _, width in self.axle)
+
+    @cached_property
+    def header_slices(self) -> tuple[tuple[str, int, int], ...]:
+        """(field, start, end) of each header field."""
+        return tuple((field, start, end) for field, (start, end) in self.columns().items())
+
+    @cached_property
+    def axle_offsets(self) -> dict[str, tuple[int, int]]:
+        """Each axle field's (start, end) within an axle's group of columns."""
+        out, at = {}, 0
+        for field, width in self.axle:
+            out[field] = (at, at + width)
+            at += width
+        return out
 
     def line_width(self, axles: int) -> int:
         """Characters of a record with ``axles`` axles."""

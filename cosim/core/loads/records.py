@@ -36,7 +36,8 @@ from .formats import FORMATS, Format
 
 #: Characters a line may have (a MON record of 99 axles has 1040).
 MAX_LINE = 4096
-#: Two-digit years (CASTOR, BeDIT) from this one on are 19xx, below it 20xx.
+#: Two-digit years (CASTOR, BeDIT; and years below 100 in DITIS and MON, as BTLS's simulations write them)
+#: from this one on are 19xx, below it 20xx.
 CENTURY_PIVOT = 70
 
 
@@ -228,10 +229,15 @@ class _Line:
 
 
 _OPTIONAL = {"head", "length", "transverse", "groups"}
+#: How messages name the header fields.
+LABELS = {"gvw": "gross weight", "millis": "milliseconds", "transverse": "transverse location",
+          "groups": "axle groups", "axles": "axle count"}
 
 
 def _parse(path: Path, fmt: Format, lanes: tuple[int, int] | None) -> Iterator[VehicleRecord]:
     origin: date | None = None
+    day_key: tuple[int, int, int] | None = None
+    record_day = date(2000, 1, 1)
     previous, previous_line = -1, 0
     per_day = round(86400 / fmt.time_unit)
     for number, text in _lines(path):
@@ -239,12 +245,18 @@ def _parse(path: Path, fmt: Format, lanes: tuple[int, int] | None) -> Iterator[V
         if len(text) < fmt.header_width:
             raise line.fail(f"{len(text)} characters, fewer than the {fmt.header_width} of a "
                             f"{fmt.name.upper()} record's vehicle fields; is the format right?")
-        raw: dict[str, int] = {}
-        at = 0
-        for field, width in fmt.header:
-            raw[field] = line.integer(at, width, field, required=field not in _OPTIONAL)
-            at += width
-        record_day = _day(line, raw, fmt)
+        if "_" in text or "+" in text:  # int() would take "1_0" and "+1"; no field has them
+            raise line.fail("has '_' or '+'; a WIM record is digits, spaces and minus signs in fixed-width columns")
+        try:
+            raw = {field: int(text[a:b]) for field, a, b in fmt.header_slices}
+            if min(raw.values()) < 0:
+                raise ValueError
+        except ValueError:  # a blank optional field is 0; anything else is named by the careful path
+            raw = {field: line.integer(a, b - a, LABELS.get(field, field), required=field not in _OPTIONAL)
+                   for field, a, b in fmt.header_slices}
+        key = (raw["year"], raw["month"], raw["day"])
+        if key != day_key:
+            day_key, record_day = key, _day(line, raw, fmt)
         if origin is None:
             origin = record_day
         ticks = _ticks(line, raw, fmt) + (record_day - origin).days * per_day
@@ -257,7 +269,7 @@ def _parse(path: Path, fmt: Format, lanes: tuple[int, int] | None) -> Iterator[V
 
 def _day(line: _Line, raw: dict[str, int], fmt: Format) -> date:
     year = raw["year"]
-    if fmt.year_digits == 2:
+    if year < 100:  # two digits, or BTLS's simulated calendar (year 0, 1, ...) in a four-digit field
         year += 1900 if year >= CENTURY_PIVOT else 2000
     try:
         return date(year, raw["month"], raw["day"])
@@ -344,6 +356,35 @@ def _axles(line: _Line, fmt: Format, n: int) -> tuple[list[int], list[int], list
     """Axle weights, the n - 1 spacings, track widths (DITIS) and MON's spacing after the last axle."""
     slots = fmt.max_axles if fmt.padded else max(n, -(-(len(line.text) - fmt.header_width) // fmt.axle_width))
     line.text = line.text.ljust(fmt.line_width(slots))
+    try:
+        return _axles_fast(line.text, fmt, n, slots)
+    except ValueError:  # a blank, a non-number, a zero inside or a value past the axles: named carefully
+        return _axles_careful(line, fmt, n, slots)
+
+
+def _axles_fast(text: str, fmt: Format, n: int, slots: int) -> tuple[list[int], list[int], list[int], int]:
+    """The axle fields of a well-formed line, or ValueError for anything :func:`_axles_careful` must name."""
+    h, w = fmt.header_width, fmt.axle_width
+    a, b = fmt.axle_offsets["weight"]
+    weights = [int(text[h + i * w + a:h + i * w + b]) for i in range(n)]
+    a, b = fmt.axle_offsets["spacing"]
+    spacings = [int(text[h + i * w + a:h + i * w + b]) for i in range(n - 1)]
+    if min(weights) <= 0 or (spacings and min(spacings) <= 0):
+        raise ValueError
+    trailing = int(text[h + (n - 1) * w + a:h + (n - 1) * w + b]) if fmt.spacing_after_last else 0
+    tracks: list[int] = []
+    if "track" in fmt.axle_offsets:
+        c, d = fmt.axle_offsets["track"]
+        tracks = [int(text[h + i * w + c:h + i * w + d]) for i in range(n)]
+    # past the axles: the spacing after the last axle (if the format has none there) and every later slot
+    rest = text[h + (n - 1) * w + a:] if not fmt.spacing_after_last else text[h + n * w:]
+    if trailing < 0 or (tracks and min(tracks) < 0) or rest.strip(" 0"):
+        raise ValueError
+    return weights, spacings, tracks, trailing
+
+
+def _axles_careful(line: _Line, fmt: Format, n: int, slots: int) -> tuple[list[int], list[int], list[int], int]:
+    """:func:`_axles` field by field, naming the first bad one."""
     weights: list[int] = []
     spacings: list[int] = []
     tracks: list[int] = []
@@ -423,7 +464,8 @@ def _format_record(fmt: Format, record: VehicleRecord, origin: date, ticks: int,
         if field == "head":
             value %= 10 ** width
         if not 0 <= value < 10 ** width:
-            raise ConfigError(f"{path}: record {index} (vehicle at {record.time:g} s): its {field} is {value} in "
+            raise ConfigError(f"{path}: record {index} (vehicle at {record.time:g} s): its {LABELS.get(field, field)} "
+                              f"is {value} in "
                               f"{fmt.name.upper()}'s units, which does not fit {width} digits (0 to {10 ** width - 1})")
         return str(value).rjust(width)
 
