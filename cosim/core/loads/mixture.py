@@ -98,7 +98,7 @@ class Mixture:
             m, v = _truncated_moments(mode, self.lower, self.upper)
             means += p * m
             second += p * (v + m * m)
-        return means, math.sqrt(max(second - means * means, 0.0))
+        return float(means), math.sqrt(max(float(second - means * means), 0.0))
 
     def sampler(self) -> MixtureSampler:
         """The precomputed form that draws from two uniforms (built once per mixture and kept)."""
