@@ -21,10 +21,11 @@ from cosim.errors import ConfigError
 
 DRAWS = 10_000  # per class and direction: KS at this size detects a 2 % shift of a 50 kN-wide mode
 ALPHA = 0.01
-#: The draws' seed. About 40 tests here each pass at p > 0.01, so a seed fails one of them by chance about one
-#: time in three; seed 11 did (the 5-axle first spacing, p = 0.004), and so did the hash's raw uniforms behind it
-#: (p = 0.004 too): chance in the uniforms, not the model. These tests draw with seed 12 (all pass).
-SEED = 12
+#: The draws' seed. About 40 tests here each pass at p > 0.01, so any seed fails one of them by chance about one
+#: time in three: while the hash's label was "cosim.loads", seed 11 failed the 5-axle first spacing (p = 0.004),
+#: and the hash's raw uniforms behind it had p = 0.004 too: chance in the uniforms, not the model. With the label
+#: "cosim-loads" every test passes with seed 11. A failure after a change is to be looked at that way.
+SEED = 11
 
 
 @pytest.fixture(scope="module")
@@ -156,7 +157,7 @@ def test_a_draw_depends_only_on_the_seed_and_the_vehicles_id(auxerre):
     assert forward[0].gross_weight == pytest.approx(FIXED_GVW, rel=1e-12)
 
 
-FIXED_GVW = 490865.93079261377  # N: Auxerre, seed 42, "flow0.0", direction 1 (cosim's draw when it was written)
+FIXED_GVW = 393849.64930879854  # N: Auxerre, seed 42, "flow0.0", direction 1 (cosim's draw when it was written)
 
 
 def test_cars_draw_from_their_own_light_distribution():

@@ -42,7 +42,7 @@ def uniforms(seed: int, vehicle_id: str, stream: str, count: int) -> list[float]
     """``count`` uniforms in [0, 1) for one vehicle and purpose, the same in every process and release.
 
     They are the top 53 bits of consecutive little-endian 64-bit words of SHAKE-256 (FIPS 202, an
-    extendable-output hash) of ``"cosim.loads", seed, stream, vehicle_id`` (UTF-8, NUL-separated).
+    extendable-output hash) of ``"cosim-loads", seed, stream, vehicle_id`` (UTF-8, NUL-separated).
 
     Args:
         seed: the scenario's seed, an integer >= 0.
@@ -53,7 +53,7 @@ def uniforms(seed: int, vehicle_id: str, stream: str, count: int) -> list[float]
     Raises:
         ConfigError: ``seed`` is not an integer >= 0.
     """
-    key = f"cosim.loads\x00{check_seed(seed)}\x00{stream}\x00{vehicle_id}".encode()
+    key = f"cosim-loads\x00{check_seed(seed)}\x00{stream}\x00{vehicle_id}".encode()
     words = struct.unpack(f"<{count}Q", hashlib.shake_256(key).digest(8 * count))
     return [(w >> 11) * _TWO_TO_MINUS_53 for w in words]
 
