@@ -277,3 +277,19 @@ def test_writing_refuses_what_the_format_cannot_hold(tmp_path: Path) -> None:
     many = VehicleRecord(**{**r.__dict__, "axle_loads": (1e4,) * 10, "axle_spacings": (1.2,) * 9})
     with pytest.raises(ConfigError, match="10 axles and 9 spacings; CASTOR takes 1 to 9 axles"):
         write_records(tmp_path / "out.txt", "castor", [many])
+
+
+def test_a_mon_line_padded_with_empty_axles_reads_as_btls_reads_it(tmp_path: Path) -> None:
+    """Older BTLS releases wrote MON records padded with zero axles (as BTLS's example traffic file is);
+    BTLS reads the record's axles and ignores the rest, and so does cosim."""
+    header = "    42231 1 12010 0 015417 2 2  1295 78 2907111800"  # 2 axles, 1295 kg, 78 km/h, lane 1, direction 2
+    axles = "  596 2907  699    0"
+    path = tmp_path / "padded.mon"
+    path.write_text(header + axles + "    0    0" * 20 + "\n", encoding="ascii")
+    (r,) = read_records(path, "mon")
+    vehicles = pb.garage.read_garage_file(path, 4)
+    assert r.gross_weight == pytest.approx(vehicles[0].get_gvw() * 1e3, rel=1e-12) == 1295 * 9.81
+    assert r.axle_spacings == (2.907,) and r.direction == 2 and r.speed == pytest.approx(78 / 3.6)
+    path.write_text(header + axles + "    0   12" + "\n", encoding="ascii")
+    with pytest.raises(ConfigError, match="line 1: axle 3 weight is given|line 1: spacing 3-4 is given"):
+        survey(path, "mon")
