@@ -90,6 +90,8 @@ MAX_ATTACHMENT_BYTES = Limit("COSIM_MAX_ATTACHMENT_BYTES", 1024 * 1024 * 1024, "
                             "the attachments of a log (together)")
 #: Bytes of one record of a log outside the chunks (metadata, schemas, ...), attachments aside.
 MAX_RECORD_BYTES = Limit("COSIM_MAX_RECORD_BYTES", 64 * 1024 * 1024, "bytes", "one record of a log")
+#: Records (vehicles) of one WIM record file: streamed in constant memory, so this bounds the time a file takes.
+MAX_WIM_RECORDS = Limit("COSIM_MAX_WIM_RECORDS", 200_000_000, "records", "one WIM record file")
 
 ALL_LIMITS: tuple[Limit, ...] = (MAX_DOFS, MAX_SECTION_TRIANGLES, MAX_ROAD_POINTS, MAX_ROAD_FILE_BYTES, MAX_STEPS,
-                                 MAX_RUNS, MAX_CHUNK_BYTES, MAX_ATTACHMENT_BYTES, MAX_RECORD_BYTES)
+                                 MAX_RUNS, MAX_CHUNK_BYTES, MAX_ATTACHMENT_BYTES, MAX_RECORD_BYTES, MAX_WIM_RECORDS)
