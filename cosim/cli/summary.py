@@ -257,6 +257,11 @@ def _run_lines(outcome: RunOutcome) -> list[str]:
     result, duration = outcome.result, outcome.duration
     events, steps = result.liftoff_events, result.liftoff_steps
     lines = [f"Lift-off events: {events} ({steps} vehicle-steps with a negative contact force)"]
+    if result.weights:
+        parts = [f"{name} {w.count} (mean {w.mean / 1e3:.1f}, sd {w.sd / 1e3:.1f}, {w.low / 1e3:.1f} to "
+                 f"{w.high / 1e3:.1f})" for name, w in result.weights.items()]
+        lines.append("Gross weights per class, kN (vehicles that came onto the deck; /cosim/vehicle_loads has each "
+                     "one's): " + "; ".join(parts))
     if events:
         lines.append("  the contact is kept (bilateral) through a lift-off, as in the paper: "
                      "results after it assume the wheel stays on the deck")

@@ -44,7 +44,7 @@ from .element import DECK_POINT_DOFS, NODE_DOFS
 from .roughness import RoadProfile, smooth_road
 from .schemes import Scheme
 from .sensors import TIME_DERIVATIVE, Sensor, check_sensor_on, sensor_row
-from .traffic import AXLE_SEPARATOR, TrafficBlock, TrafficFrame, vehicle_of
+from .traffic import AXLE_SEPARATOR, LoadRecord, TrafficBlock, TrafficFrame, vehicle_of
 from .vehicles import KERNEL_KINDS, LINEAR, MODELS, PARAM_ROWS, STATE_ROWS, VehicleModel
 
 #: Lateral tolerance of "on the deck" for a wheel path, relative to the deck width.
@@ -60,7 +60,8 @@ class BlockReport:
     a wheel on the deck pulled (negative contact force: lift-off, counted by the
     compiled loop); ``sensors`` is (K, s); ``off_surface`` marks the steps where a
     wheel was over the deck's length but beside its surface (its lateral ``y``
-    beyond the deck's width): it loaded nothing then (rigid ground).
+    beyond the deck's width): it loaded nothing then (rigid ground); ``loads``: the
+    load records of the vehicles that came onto the deck in the block.
     """
 
     ids: tuple[str, ...]
@@ -76,6 +77,7 @@ class BlockReport:
     sensors: npt.NDArray[np.float64]
     lifted: npt.NDArray[np.bool_]
     off_surface: npt.NDArray[np.bool_] | None = None
+    loads: tuple[LoadRecord, ...] = ()
 
 
 def _fleet_parameters(models: tuple[VehicleModel, ...], columns: list[list[int]],
@@ -457,7 +459,7 @@ class CoupledSystem:
         self.t += K * self.dt
         self.n_steps += K
         return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
-                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block))
+                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block), block.loads)
 
     def _beside_surface(self, block: TrafficBlock) -> npt.NDArray[np.bool_]:
         """The block's steps at which a wheel was over the deck's length but beside its surface (it loaded

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import collections
 import csv
+import math
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -81,6 +82,41 @@ class SolverSettings:
 
 
 @dataclass(frozen=True)
+class WeightStats:
+    """Gross weights of one class of vehicles that came onto the deck (N).
+
+    Attributes:
+        count: vehicles; mean, sd: of their gross weights; low, high: the lightest and the heaviest.
+    """
+
+    count: int
+    mean: float
+    sd: float
+    low: float
+    high: float
+
+
+class _Weights:
+    """Gross-weight statistics per vehicle class from the blocks' load records (constant memory, Welford)."""
+
+    def __init__(self) -> None:
+        self.acc: dict[str, list[float]] = {}  # class -> [count, mean, M2, min, max]
+
+    def on_block(self, times, keep, report) -> None:  # noqa: ANN001 - the observer protocol
+        for record in getattr(report, "loads", ()):
+            a = self.acc.setdefault(record.vehicle_class, [0, 0.0, 0.0, math.inf, -math.inf])
+            a[0] += 1
+            delta = record.gvw - a[1]
+            a[1] += delta / a[0]
+            a[2] += delta * (record.gvw - a[1])
+            a[3], a[4] = min(a[3], record.gvw), max(a[4], record.gvw)
+
+    def stats(self) -> dict[str, WeightStats]:
+        return {k: WeightStats(int(a[0]), a[1], math.sqrt(a[2] / (a[0] - 1)) if a[0] > 1 else 0.0, a[3], a[4])
+                for k, a in sorted(self.acc.items())}
+
+
+@dataclass(frozen=True)
 class SimulationResult:
     """Time histories of a run, as numpy arrays with names.
 
@@ -103,6 +139,8 @@ class SimulationResult:
         sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
         contact_force_range: (min, max) contact force per vehicle while on the deck, N.
         max_on_deck: most vehicles on the deck at once (a vehicle's axles count once).
+        weights: gross-weight statistics per vehicle class of the vehicles that came onto the deck (from their
+            load records: ``/cosim/vehicle_loads``).
     """
 
     t: npt.NDArray[np.float64]
@@ -121,6 +159,7 @@ class SimulationResult:
     sensor_max: dict[str, float] = field(default_factory=dict)
     contact_force_range: dict[str, tuple[float, float]] = field(default_factory=dict)
     max_on_deck: int = 0
+    weights: dict[str, WeightStats] = field(default_factory=dict)
 
     def vehicle(self, vehicle_id: str) -> dict[str, npt.NDArray[np.float64]]:
         """The samples of one vehicle, column name -> array."""
@@ -353,7 +392,8 @@ def simulate(
     n_steps = int(round(duration / solver.dt))
     collector = _Collector(len(sensors)) if collect else None
     extremes = _Extremes([s.name for s in sensors])
-    watchers: list = [extremes] + ([collector] if collector else []) + list(observers)
+    weights = _Weights()
+    watchers: list = [extremes, weights] + ([collector] if collector else []) + list(observers)
     # A zero-step call compiles (or loads from cache) the kernel outside the timed run.
     empty = np.zeros((0, 0))
     system.advance(TrafficBlock((), (), empty, empty, empty, np.zeros(0)))
@@ -445,4 +485,5 @@ def simulate(
         sensor_max=dict(zip(extremes.names, extremes.s_max.tolist())),
         contact_force_range={k: (v[0], v[1]) for k, v in extremes.force.items()},
         max_on_deck=extremes.max_on_deck,
+        weights=weights.stats(),
     )

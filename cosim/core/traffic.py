@@ -19,7 +19,7 @@ import abc
 import itertools
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
@@ -31,6 +31,8 @@ from .jit import compiled
 from .vehicles import VehicleModel, model_classes
 
 AXLE_SEPARATOR = "#"
+#: A load record waits this long (s of traffic time) for its vehicle to come into a block, then is dropped.
+LOAD_RECORD_WAIT = 60.0
 
 
 def on_deck(x, length):  # noqa: ANN001, ANN201 - scalars or arrays; also compiled as is by cosim.core.kernels
@@ -70,6 +72,42 @@ class TrafficFrame:
 
 
 @dataclass(frozen=True)
+class LoadRecord:
+    """What loaded the deck, one per vehicle, as the log records it at the vehicle's entry onto the deck
+    (``/cosim/vehicle_loads``; docs/logs.md). SI units.
+
+    Attributes:
+        id: the vehicle (its contact points are ``id`` or ``id#k``).
+        vehicle_class: its class: ``car``, ``truck-N`` (a truck of N axles, Grave's classes), a SUMO vClass, or
+            the model's name for a scripted vehicle.
+        lane: the lane it drove onto the deck on: SUMO's lane id, a WIM record's (BTLS) lane number; "" if none.
+        speed: its speed at entry, m/s (filled in at entry when given as NaN).
+        gvw: gross weight, N.
+        axle_loads: each axle's static load, N, front first (they add up to ``gvw``).
+        axle_spacings: each axle to the next, m (one fewer than the axles).
+        y: its path's lateral offset on the deck, m (the lane's, plus ``wander``).
+        wander: its lateral offset within its lane, m (0 without wander).
+        source: where its loads came from (a WIM site model, "records: FILE", "vType params", "cosim default",
+            "scripted").
+    """
+
+    id: str
+    vehicle_class: str
+    lane: str
+    speed: float
+    gvw: float
+    axle_loads: tuple[float, ...]
+    axle_spacings: tuple[float, ...]
+    y: float
+    wander: float
+    source: str
+
+    @property
+    def n_axles(self) -> int:
+        return len(self.axle_loads)
+
+
+@dataclass(frozen=True)
 class TrafficBlock:
     """Vehicles over K consecutive beam steps: one fleet, kinematics per step.
 
@@ -79,6 +117,7 @@ class TrafficBlock:
             A vehicle whose x lies outside [0, L] at a step is off the deck then
             (on the approach road, rigid ground).
         y: lateral offsets (q,), m.
+        loads: the :class:`LoadRecord` of each vehicle that comes onto the deck for the first time in the block.
     """
 
     ids: tuple[str, ...]
@@ -87,6 +126,7 @@ class TrafficBlock:
     v: npt.NDArray[np.float64]
     a: npt.NDArray[np.float64]
     y: npt.NDArray[np.float64]
+    loads: tuple[LoadRecord, ...] = ()
 
     @classmethod
     def from_frame(cls, frame: TrafficFrame) -> TrafficBlock:
@@ -101,7 +141,8 @@ class TrafficBlock:
         """Consecutive blocks of one fleet (:meth:`same_fleet`) as one block of all their steps."""
         first = blocks[0]
         return TrafficBlock(first.ids, first.models, np.concatenate([b.x for b in blocks]),
-                            np.concatenate([b.v for b in blocks]), np.concatenate([b.a for b in blocks]), first.y)
+                            np.concatenate([b.v for b in blocks]), np.concatenate([b.a for b in blocks]), first.y,
+                            tuple(r for b in blocks for r in b.loads))
 
 
 class TrafficSource(abc.ABC):
@@ -154,6 +195,7 @@ class ScriptedVehicle:
         direction: +1 drives along +x (enters at x = 0), -1 along -x (enters at x = L).
         profile: optional ((t, speed), ...) pairs, t relative to ``entry_time``;
             speed is linear between them and held after the last.
+        load: what the log records of its loads at its entry (:class:`LoadRecord`), or None.
     """
 
     id: str
@@ -163,6 +205,7 @@ class ScriptedVehicle:
     entry_time: float = 0.0
     direction: int = 1
     profile: tuple[tuple[float, float], ...] = ()
+    load: LoadRecord | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.id, str) or not self.id:
@@ -237,8 +280,22 @@ class ScriptedTraffic(TrafficSource):
         all points together, while any of them is on the deck.
         """
         times = np.asarray(times, dtype=float)
-        if any(veh.model.contacts > 1 for veh in self.vehicles):
-            return self._axle_block(times)
+        block = self._axle_block(times) if any(veh.model.contacts > 1 for veh in self.vehicles) else \
+            self._point_block(times)
+        loads = self._entering(times)
+        return replace(block, loads=loads) if loads else block
+
+    def _entering(self, times: npt.NDArray[np.floating]) -> tuple[LoadRecord, ...]:
+        """The load records of the vehicles whose front contact reaches the deck in the block: at an entry
+        time in [t_k - dt, t_k) for one of its steps t_k (each time belongs to one step, blocks follow on)."""
+        if len(times) < 2:
+            return ()
+        start = times[0] - (times[1] - times[0])
+        return tuple(veh.load for veh in self.vehicles
+                     if veh.load is not None and start <= veh.entry_time < times[-1])
+
+    def _point_block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
+        """:meth:`block` for vehicles of one contact point each."""
         n = len(self.vehicles)
         s = np.empty((len(times), n))
         v = np.empty_like(s)
@@ -322,6 +379,7 @@ class Frame:
         t: time, s (simulation time of the co-simulation, from 0).
         ids: vehicle ids; x (m, contact point along the axis), y (m), v, a (along +x).
         types: the vehicle type of each vehicle (key into the model table).
+        loads: the :class:`LoadRecord` of each vehicle that came onto the deck since the frame before.
     """
 
     t: float
@@ -331,6 +389,7 @@ class Frame:
     v: npt.NDArray[np.float64]
     a: npt.NDArray[np.float64]
     types: tuple[str, ...]
+    loads: tuple[LoadRecord, ...] = ()
 
 
 def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
@@ -341,20 +400,21 @@ def pack_frames(frames: list[Any]) -> tuple[Any, ...]:
     return ([f.t for f in frames], [len(f.ids) for f in frames],
             tuple(itertools.chain.from_iterable(f.ids for f in frames)),
             tuple(itertools.chain.from_iterable(f.types for f in frames)),
-            *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")))
+            *(np.concatenate([getattr(f, c) for f in frames]) for c in ("x", "y", "v", "a")),
+            {k: f.loads for k, f in enumerate(frames) if f.loads})
 
 
 def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
     """The frames of :func:`pack_frames`, equal to those packed (the same numbers, bit for bit)."""
     if not packed:
         return []
-    times, counts, ids, types, x, y, v, a = packed
+    times, counts, ids, types, x, y, v, a, loads = packed
     out = []
     start = 0
-    for t, n in zip(times, counts):
+    for k, (t, n) in enumerate(zip(times, counts)):
         end = start + n
         out.append(Frame(t=t, ids=ids[start:end], x=x[start:end], y=y[start:end], v=v[start:end], a=a[start:end],
-                         types=types[start:end]))
+                         types=types[start:end], loads=loads.get(k, ())))
         start = end
     return out
 
@@ -385,10 +445,15 @@ class FrameTraffic(TrafficSource):
         self._models: dict[str, VehicleModel] = dict(models or {})
         self.frames: list[Frame] = [Frame(0.0, (), *(np.zeros(0),) * 4, ())]
         self._first = 0  # index in self.frames of frames[0]; older frames are dropped
+        self._loads: dict[str, tuple[LoadRecord, float]] = {}  # vehicle -> its record and its frame's time
 
     def add_models(self, models: Mapping[str, VehicleModel]) -> None:
         """Vehicle types (type -> model) that frames may name from now on."""
         self._models.update(models)
+
+    def add_load_record(self, record: LoadRecord, t: float) -> None:
+        """A vehicle's load record (known at time ``t``, s), to go with the first block that carries it."""
+        self._loads[record.id] = (record, float(t))
 
     def add_frame(self, frame: Frame, new_models: Mapping[str, VehicleModel] | None = None) -> None:
         """Append the next frame (its time one ``step`` after the last), and the vehicle types that became known
@@ -402,6 +467,8 @@ class FrameTraffic(TrafficSource):
         for typ in frame.types:
             if typ not in own:
                 raise ConfigError(f"no vehicle model for vehicle type {typ!r}")
+        for record in frame.loads:
+            self._loads[record.id] = (record, frame.t)
         self.frames.append(frame)
 
     @property
@@ -418,6 +485,9 @@ class FrameTraffic(TrafficSource):
         if drop > 0:
             del self.frames[:drop]
             self._first += drop
+        if self._loads:  # a record whose vehicle never came into a block (it never reached the deck's steps)
+            stale = t - LOAD_RECORD_WAIT
+            self._loads = {k: v for k, v in self._loads.items() if v[1] >= stale}
 
     def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         times = np.asarray(times, dtype=float)
@@ -461,6 +531,7 @@ class FrameTraffic(TrafficSource):
         if any(models[type_of[c]].contacts > 1 for c in np.flatnonzero(wanted).tolist()):
             wanted = self._whole_vehicles(ids, wanted)
         keep = np.flatnonzero(wanted)
+        loads = self._records_of([ids[c] for c in keep.tolist()]) if self._loads else ()
         X, V, A = X[:, keep], V[:, keep], A[:, keep]
         # One lateral offset per block: where the contact point was at its last frame in the block on the deck's
         # length (a vehicle turning off the deck at its end keeps the lane it had on it), else at its last frame.
@@ -471,8 +542,17 @@ class FrameTraffic(TrafficSource):
         Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
         return TrafficBlock(
             tuple(ids[c] for c in keep.tolist()), tuple(models[type_of[c]] for c in keep.tolist()),
-            np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y,
+            np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y, loads,
         )
+
+    def _records_of(self, contact_ids: list[str]) -> tuple[LoadRecord, ...]:
+        """The waiting load records of the vehicles these contact points belong to, taken (each once)."""
+        out = []
+        for owner in dict.fromkeys(vehicle_of(c) for c in contact_ids):
+            entry = self._loads.pop(owner, None)
+            if entry is not None:
+                out.append(entry[0])
+        return tuple(out)
 
     @staticmethod
     def _whole_vehicles(ids: list[str], wanted: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:

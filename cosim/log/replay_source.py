@@ -13,17 +13,22 @@ read (:mod:`cosim.log.reader`), and malformed traffic is a
 """
 from __future__ import annotations
 
+import collections
 import os
 from pathlib import Path
 
 import numpy as np
 
-from cosim.core.traffic import Frame, FrameTraffic, TrafficBlock, TrafficSource
+from cosim.core.traffic import Frame, FrameTraffic, LoadRecord, TrafficBlock, TrafficSource
 from cosim.core.vehicles import model_from_dict
 from cosim.errors import ConfigError, LogError
 
 from .reader import LogContents, iter_messages, read_log
-from .schemas import TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES
+from .schemas import TOPIC_TRAFFIC, TOPIC_VEHICLE_LOADS, TOPIC_VEHICLE_TYPES
+
+#: How far (s of logged time) the replay reads frames beyond the block it builds: a logged run writes the load
+#: records of a block after the frames of the piece that follows it (cosim.log.writer.BlockLogger).
+READ_AHEAD = 5.0
 
 
 def _frame(path: Path, message: dict) -> Frame:
@@ -58,6 +63,16 @@ class _FrameFeed:
         except (ConfigError, KeyError, TypeError, ValueError) as exc:
             raise LogError(f"{self.path}: a vehicle type on {TOPIC_VEHICLE_TYPES} (t = {message['t']:g} s) is not "
                            f"a valid vehicle model: {exc}") from None
+
+    def vehicle_load(self, message: dict) -> None:
+        """A logged ``/cosim/vehicle_loads`` message: the vehicle's load record goes with the replay's blocks
+        again (so the replay's log records it too)."""
+        record = LoadRecord(id=message["id"], vehicle_class=message["class"], lane=message["lane"],
+                            speed=float(message["speed"]), gvw=float(message["gvw"]),
+                            axle_loads=tuple(float(v) for v in message["axle_loads"]),
+                            axle_spacings=tuple(float(v) for v in message["axle_spacings"]),
+                            y=float(message["y"]), wander=float(message["wander"]), source=message["source"])
+        self.traffic.add_load_record(record, float(message["t"]))
 
     def pad(self, t_end: float) -> None:
         """Empty frames while one more still ends before ``t_end`` (half a step of slack for round-off)."""
@@ -100,12 +115,16 @@ def traffic_from_log(contents: LogContents, length: float, step: float, until: f
         raise LogError(f"{contents.path}: no traffic frames ({TOPIC_TRAFFIC}) in this log")
     feed = _FrameFeed(contents.path, length, step)
     merged = sorted([(ns, 0, m) for ns, m in contents.messages.get(TOPIC_VEHICLE_TYPES, [])]
-                    + [(ns, 1, m) for ns, m in frames], key=lambda e: (e[0], e[1]))
+                    + [(ns, 1, m) for ns, m in frames]
+                    + [(ns, 2, m) for ns, m in contents.messages.get(TOPIC_VEHICLE_LOADS, [])],
+                    key=lambda e: (e[0], e[1]))
     for _, kind, message in merged:
         if kind == 0:
             feed.vehicle_type(message)
-        else:
+        elif kind == 1:
             feed.frame(message)
+        else:
+            feed.vehicle_load(message)
     if until is not None:
         feed.pad(until)
     return feed.traffic
@@ -115,7 +134,7 @@ def read_traffic(path: str | os.PathLike[str], length: float, step: float, until
                  ) -> tuple[FrameTraffic, int]:
     """The logged SUMO frames of the log at ``path`` as a traffic source (see :func:`traffic_from_log`),
     and how many frames the log holds."""
-    contents = read_log(path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
+    contents = read_log(path, topics=[TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, TOPIC_VEHICLE_LOADS])
     return traffic_from_log(contents, length, step, until), len(contents.messages.get(TOPIC_TRAFFIC, []))
 
 
@@ -141,8 +160,8 @@ class LoggedTraffic(TrafficSource):
         self.length = float(length)
         self.until = float(until)
         self._feed = _FrameFeed(self.path, length, step)
-        self._messages = iter_messages(self.path, [TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES])
-        self._pending: dict | None = None  # the next logged frame, read but not yet needed
+        self._messages = iter_messages(self.path, [TOPIC_TRAFFIC, TOPIC_VEHICLE_TYPES, TOPIC_VEHICLE_LOADS])
+        self._waiting: collections.deque[dict] = collections.deque()  # logged frames read, not yet needed
         self._exhausted = False
 
     def check(self) -> int:
@@ -167,34 +186,38 @@ class LoggedTraffic(TrafficSource):
         """Logged (non-empty) frames read so far."""
         return self._feed.frames
 
-    def _next_frame(self) -> dict | None:
-        """The next logged frame (vehicle types on the way are taken in), or None at the end of the log."""
-        for topic, message in self._messages:
-            if topic == TOPIC_VEHICLE_TYPES:
-                self._feed.vehicle_type(message)
+    def _read_ahead(self, until: float) -> None:
+        """Read the log on until a frame after ``until`` (s) is waiting, or its end: vehicle types and load
+        records on the way are taken in, frames wait in order."""
+        while not self._exhausted and (not self._waiting or float(self._waiting[-1]["t"]) <= until):
+            for topic, message in self._messages:
+                if topic == TOPIC_VEHICLE_TYPES:
+                    self._feed.vehicle_type(message)
+                elif topic == TOPIC_VEHICLE_LOADS:
+                    self._feed.vehicle_load(message)
+                else:
+                    self._waiting.append(message)
+                    break
             else:
-                return message
-        self._exhausted = True
-        return None
+                self._exhausted = True
 
     def block(self, times: np.ndarray) -> TrafficBlock:
         """The vehicles at ``times`` (s), interpolated between the logged frames (the TrafficSource protocol).
 
-        Frames are read, and the empty ones between them made, only as far as ``times`` need: a long
-        stretch without vehicles costs no memory either.
+        Frames are read, and the empty ones between them made, only as far as ``times`` need (and
+        :data:`READ_AHEAD` beyond: a run logs a block's load records after the frames of the block that
+        follows it): a long stretch without vehicles costs no memory either.
         """
         traffic = self._feed.traffic
         step = self._feed.step
         need = float(times[-1])
+        self._read_ahead(need + READ_AHEAD)
         while traffic.last_time < need - 1e-9:
-            if self._pending is None and not self._exhausted:
-                self._pending = self._next_frame()
-            if self._pending is not None and float(self._pending["t"]) < need + 0.5 * step:
-                self._feed.frame(self._pending)  # the empty frames before it, then it
-                self._pending = None
+            if self._waiting and float(self._waiting[0]["t"]) < need + 0.5 * step:
+                self._feed.frame(self._waiting.popleft())  # the empty frames before it, then it
             else:  # the next logged frame lies beyond: empty frames up to ``need``
                 self._feed.pad(min(need, self.until) + 0.5 * step - 1e-9)
-                if self._pending is None and self._exhausted and traffic.last_time < need - 1e-9:
+                if not self._waiting and self._exhausted and traffic.last_time < need - 1e-9:
                     break  # past the replay's end: FrameTraffic says so
         out = traffic.block(times)
         traffic.forget_before(need)

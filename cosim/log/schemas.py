@@ -27,6 +27,8 @@ TOPIC_EVENTS = "/cosim/events"
 TOPIC_STATUS = "/cosim/status"
 TOPIC_TRAFFIC = "/cosim/traffic"
 TOPIC_VEHICLE_TYPES = "/cosim/vehicle_types"
+#: What loaded the deck: one message per vehicle at its entry (class, weights, axles, lane, path, source).
+TOPIC_VEHICLE_LOADS = "/cosim/vehicle_loads"
 #: The 3D scene (Foxglove's own schemas): the deck, its vehicles and sensors at the scene rate ...
 TOPIC_SCENE = "/cosim/scene"
 #: ... what does not move (the deck at rest, the approaches, the sensors' names), once at t = 0 ...
@@ -108,6 +110,28 @@ TRAFFIC_SCHEMA = {
         "types": {"type": "array", "items": {"type": "string"}},
     },
     "required": ["t", "ids", "x", "y", "speed", "acceleration", "types"], "additionalProperties": False,
+}
+_NUMBERS = {"type": "array", "items": _NUMBER}
+VEHICLE_LOADS_SCHEMA = {
+    "title": "cosim.VehicleLoads", "type": "object",
+    "description": "What loaded the deck, per vehicle, at its entry onto the deck (SI units).",
+    "properties": {
+        "t": {"type": "number", "description": "when its first axle came onto the deck, s"},
+        "id": {"type": "string"},
+        "class": {"type": "string", "description": "car, truck-N (N axles), a SUMO vClass or a model's name"},
+        "lane": {"type": "string", "description": "SUMO's lane id or a WIM record's (BTLS) lane number"},
+        "speed": {"type": "number", "description": "at entry, m/s"},
+        "gvw": {"type": "number", "description": "gross weight, N"},
+        "n_axles": {"type": "integer"},
+        "axle_loads": {**_NUMBERS, "description": "static load of each axle, N, front first"},
+        "axle_spacings": {**_NUMBERS, "description": "each axle to the next, m"},
+        "y": {"type": "number", "description": "lateral offset of its path on the deck, m (wander included)"},
+        "wander": {"type": "number", "description": "its lateral offset within its lane, m"},
+        "source": {"type": "string", "description": "where its loads came from"},
+    },
+    "required": ["t", "id", "class", "lane", "speed", "gvw", "n_axles", "axle_loads", "axle_spacings", "y",
+                 "wander", "source"],
+    "additionalProperties": False,
 }
 VEHICLE_TYPE_SCHEMA = {
     "title": "cosim.VehicleType", "type": "object",
@@ -195,6 +219,7 @@ def topic_schemas(sensor_names: Iterable[str], scene: bool = False) -> list[tupl
         (TOPIC_STATUS, STATUS_SCHEMA),
         (TOPIC_TRAFFIC, TRAFFIC_SCHEMA),
         (TOPIC_VEHICLE_TYPES, VEHICLE_TYPE_SCHEMA),
+        (TOPIC_VEHICLE_LOADS, VEHICLE_LOADS_SCHEMA),
     ]
     if scene:
         topics += [(TOPIC_SCENE, SCENE_UPDATE_SCHEMA), (TOPIC_SCENE_STATIC, SCENE_UPDATE_SCHEMA),

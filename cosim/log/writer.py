@@ -34,6 +34,7 @@ from mcap.writer import CompressionType, Writer
 
 from cosim import __version__
 from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
+from cosim.core.traffic import vehicle_of
 from cosim.core.vehicles import model_to_dict
 from cosim.errors import LogError, interruption_message
 
@@ -43,6 +44,7 @@ from .schemas import (
     TOPIC_SENSORS,
     TOPIC_STATUS,
     TOPIC_TRAFFIC,
+    TOPIC_VEHICLE_LOADS,
     TOPIC_VEHICLE_TYPES,
     TOPIC_VEHICLES,
     to_ns,
@@ -320,6 +322,15 @@ _PER_STEP = ("x", "v", "a", "on_deck", "contact_force", "body_displacement", "bo
 _REPORT_ARRAYS = {"speed": "v", "acceleration": "a"}
 
 
+def load_message(t: float, record: Any, speed: float | None = None) -> dict[str, Any]:
+    """A :class:`cosim.core.traffic.LoadRecord` as its ``/cosim/vehicle_loads`` message at time ``t`` (s)."""
+    return {"t": t, "id": record.id, "class": record.vehicle_class, "lane": record.lane,
+            "speed": float(record.speed if speed is None else speed), "gvw": float(record.gvw),
+            "n_axles": len(record.axle_loads), "axle_loads": [float(v) for v in record.axle_loads],
+            "axle_spacings": [float(v) for v in record.axle_spacings], "y": float(record.y),
+            "wander": float(record.wander), "source": record.source}
+
+
 class BlockLogger:
     """Observer of :func:`cosim.core.simulation.simulate` that streams every block into a :class:`LogRecorder`.
 
@@ -476,6 +487,8 @@ class BlockLogger:
             if frames and self._traffic is not None:
                 self._traffic.write_frames(frames)
             return
+        if report.loads:
+            self._write_loads(times, report)
         piece = self.piece_steps or len(times)
         for lo in range(0, len(times), piece):
             hi = min(lo + piece, len(times))
@@ -512,6 +525,20 @@ class BlockLogger:
             rec.status(float(times[-1]), "running", progress=float(times[-1] / self.total_time))
             rec.flush()
             self._next_status += self.status_every
+
+    def _write_loads(self, times, report) -> None:  # noqa: ANN001
+        """One ``/cosim/vehicle_loads`` message per vehicle that came onto the deck in the block, at the step its
+        first contact point did (its speed then, when the record leaves it to the entry)."""
+        owners = [vehicle_of(i) for i in report.ids]
+        for record in report.loads:
+            cols = [j for j, o in enumerate(owners) if o == record.id]
+            on = report.on_deck[:, cols].any(axis=1) if cols else np.zeros(len(times), dtype=bool)
+            k = int(np.argmax(on)) if on.any() else 0
+            speed = record.speed
+            if not np.isfinite(speed):
+                speed = abs(float(report.v[k, cols[0]])) if cols else 0.0
+            t = float(times[k])
+            self.rec.write(TOPIC_VEHICLE_LOADS, t, load_message(t, record, speed))
 
     def _gone(self, times, report) -> None:
         """Vehicles on the deck at the end of the last block that the traffic no longer has: they left

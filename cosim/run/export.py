@@ -18,6 +18,7 @@ from cosim.log.schemas import (
     TOPIC_EVENTS,
     TOPIC_SENSORS,
     TOPIC_STATUS,
+    TOPIC_VEHICLE_LOADS,
     TOPIC_VEHICLES,
 )
 
@@ -28,11 +29,14 @@ if TYPE_CHECKING:  # the reader loads mcap and numpy: only when a log is read
     from cosim.log.records import ReadStats
 
 #: The topics a log can be exported from.
-EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS)
+EXPORT_TOPICS = (TOPIC_SENSORS, TOPIC_VEHICLES, TOPIC_EVENTS, TOPIC_STATUS, TOPIC_VEHICLE_LOADS)
 #: Columns of each topic's CSV but the sensors' (``t,<sensor names>``).
 VEHICLE_COLUMNS = ("t", *(f.name for f in VEHICLE_FIELDS))
 EVENT_COLUMNS: tuple[str, ...] = tuple(EVENTS_SCHEMA["properties"])  # type: ignore[arg-type]
 STATUS_COLUMNS: tuple[str, ...] = tuple(STATUS_SCHEMA["properties"])  # type: ignore[arg-type]
+#: ``/cosim/vehicle_loads`` (SI: weights in N, spacings in m; lists ``;``-separated).
+VEHICLE_LOAD_COLUMNS = ("t", "id", "class", "lane", "speed", "gvw", "n_axles", "axle_loads", "axle_spacings", "y",
+                        "source")
 
 
 def _cell(value: Any) -> str:
@@ -40,6 +44,8 @@ def _cell(value: Any) -> str:
         return ""
     if isinstance(value, float):
         return repr(value)
+    if isinstance(value, list):
+        return ";".join(_cell(v) for v in value)
     return str(value)
 
 
@@ -49,8 +55,9 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
     """Write one topic of a log as CSV (SI units, a header row); returns (rows, columns).
 
     ``/cosim/sensors``: ``t,<sensor names>``; ``/cosim/vehicles``: one row per
-    vehicle per sample (:data:`VEHICLE_COLUMNS`); events and status: one row per
-    message. With ``start`` and/or ``end`` (s of simulated time, both included),
+    vehicle per sample (:data:`VEHICLE_COLUMNS`); events, status and vehicle loads
+    (:data:`VEHICLE_LOAD_COLUMNS`, lists ``;``-separated): one row per message.
+    With ``start`` and/or ``end`` (s of simulated time, both included),
     only the messages in that window: exactly the rows of the whole export whose
     message lies in it, read from the chunks that overlap it
     (:func:`cosim.log.reader.iter_messages`). A log cut short is exported up to
@@ -77,6 +84,8 @@ def export_csv(log: str | os.PathLike[str], out: str | os.PathLike[str], topic: 
         columns = list(VEHICLE_COLUMNS)
     elif topic == TOPIC_EVENTS:
         columns = list(EVENT_COLUMNS)
+    elif topic == TOPIC_VEHICLE_LOADS:
+        columns = list(VEHICLE_LOAD_COLUMNS)
     else:
         columns = list(STATUS_COLUMNS)
     check_not_input(out, "CSV", [("the log", log)])

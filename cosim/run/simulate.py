@@ -34,6 +34,7 @@ from .scenario import Scenario
 
 if TYPE_CHECKING:
     from cosim.sumo.adapter import SumoSettings
+    from cosim.sumo.loads import LoadSettings
 
 #: Exceptions of the compiled solver (numba, numpy) when non-finite values reach it: a diverged solution.
 SOLVER_FAILURES = (np.linalg.LinAlgError, FloatingPointError, ZeroDivisionError, OverflowError)
@@ -154,11 +155,38 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         except SumoError as exc:
             where = f"{entry.file}: " if entry is not None else ""
             raise ConfigError(f"{scenario.source}: traffic.sumo_config: {where}{exc}") from None
+    loads = _load_settings(scenario, demand) if t.loads is not None else None
     with scenario.named("traffic"):
         settings = SumoSettings(config, axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
-                                seed=t.seed, deck_y=deck_y, demand=demand)
+                                seed=t.seed, deck_y=deck_y, demand=demand, loads=loads)
     return SumoPlan(config=config, net=net, axis=axis, axis_from=axis_from, location=location, deck_y=deck_y,
                     demand=demand, types=tuple(types), settings=settings)
+
+
+def _load_settings(scenario: Scenario, demand: Any) -> LoadSettings:
+    """``[traffic.loads]`` lowered: the site's model read (its files checked), the vTypes it maps checked."""
+    import difflib
+
+    from cosim.core.loads import load_model
+    from cosim.sumo.loads import LoadSettings
+
+    t = scenario.traffic
+    assert t is not None and t.loads is not None
+    try:
+        model = load_model(t.loads.model, scenario.base_dir)
+    except ConfigError as exc:
+        text = str(exc)
+        where = "" if text.startswith("traffic.loads.model") else "traffic.loads.model: "
+        raise ConfigError(f"{scenario.source}: {where}{text}") from None
+    known = [v for v in demand.vtypes if v not in demand.distributions]
+    for vtype in t.loads.vtype_classes:
+        if vtype not in known:
+            near = difflib.get_close_matches(vtype, known, n=1)
+            hint = f"did you mean {near[0]!r}? " if near else ""
+            raise ConfigError(f"{scenario.source}: traffic.loads.vtype_classes.{vtype}: the demand has no vType "
+                              f"{vtype!r} ({hint}its vTypes: {', '.join(known)})")
+    return LoadSettings(model=model, site=model.name, seed=t.loads.seed, vtype_classes=dict(t.loads.vtype_classes),
+                        wander=t.loads.wander)
 
 
 def build_traffic(scenario: Scenario, frame_sink: FrameSink | None = None, plan: SumoPlan | None = None,

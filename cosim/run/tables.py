@@ -70,6 +70,7 @@ __all__ = [
     "SNCurveConfig",
     "SensorConfig",
     "SolverConfig",
+    "LoadsConfig",
     "TrafficConfig",
     "CONTACTS",
     "VEHICLE_MODELS",
@@ -453,6 +454,44 @@ class RoadConfig(ConfigModel):
         return not self.random and self.profile is None
 
 
+#: Lateral wander of ``[traffic.loads]``: EN 1991-2 §4.6.1 Figure 4.6, none, or a normal distribution's sd (m).
+WANDERS: tuple[str, ...] = ("en1991-2", "none")
+#: What ``vtype_classes`` may give a vType besides truck classes (axle counts 2-5): the light distribution, or
+#: the vType's own weights.
+VTYPE_CLASS_WORDS: tuple[str, ...] = ("car", "fixed")
+
+
+def _wander(value: Any) -> str | float:
+    """``wander = "en1991-2" | "none" | <sd, m>``."""
+    if isinstance(value, str) and value in WANDERS:
+        return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and 0 < value <= 1.0:
+        return float(value)
+    raise fail(f"expected {', '.join(WANDERS)} or the standard deviation of a normal wander, a number > 0 and "
+               f"<= 1 m (got {describe(value)})")
+
+
+def _vtype_class(value: Any) -> tuple[int, ...] | str:
+    """A vType's classes: a list of axle counts (2-5), "car" or "fixed"."""
+    if isinstance(value, str) and value in VTYPE_CLASS_WORDS:
+        return value
+    if isinstance(value, (list, tuple)) and value and all(
+            isinstance(c, int) and not isinstance(c, bool) and 2 <= c <= 5 for c in value):
+        return tuple(sorted(set(value)))
+    raise fail(f"expected a list of truck classes (axle counts 2 to 5, e.g. [4, 5]), \"car\" (the light "
+               f"distribution) or \"fixed\" (the vType's own weights); got {describe(value)}")
+
+
+class LoadsConfig(ConfigModel):
+    """``[traffic.loads]``: every vehicle's weight and axles drawn from a WIM-calibrated model (docs/loads.md)."""
+
+    model: Annotated[str, Strict(), Field(min_length=1)]
+    seed: Annotated[int, Strict(), Field(ge=0)]
+    vtype_classes: dict[Annotated[str, Strict(), Field(min_length=1)],
+                        Annotated[tuple[int, ...] | str, PlainValidator(_vtype_class)]] = {}
+    wander: Annotated[str | float, PlainValidator(_wander)] = "en1991-2"
+
+
 class TrafficConfig(ConfigModel):
     """``[traffic]``: vehicles from a SUMO simulation (instead of scripted ``[[vehicles]]``)."""
 
@@ -463,6 +502,7 @@ class TrafficConfig(ConfigModel):
     seed: Annotated[int, Strict(), Field(ge=0)] | None = None
     axis: tuple[NetPoint, NetPoint] | None = None
     edges: tuple[Annotated[str, Strict(), Field(min_length=1)], ...] = ()
+    loads: LoadsConfig | None = None
 
     @model_validator(mode="after")
     def _times(self) -> TrafficConfig:

@@ -32,6 +32,7 @@ imported inside :meth:`SumoTraffic.start`, so importing this module does not loa
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import shutil
 import sys
@@ -46,12 +47,13 @@ from typing import Any
 import numpy as np
 
 from cosim.core.axle_paths import AxisFrame, AxleTrails, axles_on_path, path_behind, record_fronts
-from cosim.core.traffic import Frame, FrameSink, FrameTraffic, TrafficBlock, TrafficSource
+from cosim.core.traffic import Frame, FrameSink, FrameTraffic, LoadRecord, TrafficBlock, TrafficSource
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
+from cosim.sumo.loads import LoadSettings, VehicleLoads
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
-from cosim.sumo.vtypes import VehicleType, vehicle_type
+from cosim.sumo.vtypes import LOADS_G, VehicleType, vehicle_type
 
 __all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "LiveSumo", "SumoSettings",
            "SumoTraffic", "bundled_networks", "sumo_binary"]
@@ -130,6 +132,7 @@ class SumoSettings:
         deck_y: the deck's lateral extent (y_min, y_max), m: an axle outside it is not on the bridge.
         extra_args: further SUMO command-line options.
         demand: the config's demand files as read (:func:`cosim.sumo.files.read_demand`), if already read.
+        loads: each vehicle's own loads from a WIM-calibrated model (``[traffic.loads]``), or None: the vTypes'.
 
     Raises:
         SumoError, ConfigError: a config that is not there, a step or times that are not physical.
@@ -145,6 +148,7 @@ class SumoSettings:
     deck_y: tuple[float, float] = (-50.0, 50.0)
     extra_args: tuple[str, ...] = ()
     demand: Demand | None = None
+    loads: LoadSettings | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "config", Path(self.config))
@@ -321,6 +325,10 @@ class SumoTraffic(LiveSumo):
         self.demand = settings.demand
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}  # per contact: behind the bumper, left, m
         self._sideways: set[str] = set()  # the types with a contact point beside the path (left != 0)
+        self._draws = VehicleLoads(settings.loads) if settings.loads is not None else None
+        self._own: dict[str, VehicleType] = {}  # a vehicle with its own loads -> its vehicle type
+        self._label: dict[str, tuple[str, float, str]] = {}  # vehicle -> its class, wander (m), loads' source
+        self._recorded: set[str] = set()  # vehicles whose load record went out (at their entry onto the deck)
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
         self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
@@ -540,7 +548,7 @@ class SumoTraffic(LiveSumo):
         trails = self._trails
         assert trails is not None
         for vid in self._watched - present:
-            trails.drop(vid)
+            self._forget(vid)
             try:
                 ls.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - it arrived or was teleported away: nothing to undo
@@ -552,8 +560,8 @@ class SumoTraffic(LiveSumo):
         ids = sorted(vid for vid in present if vid in results)
         rows = [results[vid] for vid in ids]
         P, H, S, A, T = tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE
-        types = [r[T] for r in rows]
-        for typ in dict.fromkeys(types):
+        vtypes = [r[T] for r in rows]
+        for typ in dict.fromkeys(vtypes):
             if typ not in self.types:
                 self._model(typ)
                 self._extend_reach()  # a longer vehicle than any known so far: watch farther
@@ -564,9 +572,12 @@ class SumoTraffic(LiveSumo):
             if vid not in trails.slot_of:
                 trails.add(vid)
                 self._seed_trail(vid, num[j])
+                self._first_sight(vid, vtypes[j], num[j])
+        own = self._own
+        types = [own[vid].id if vid in own else typ for vid, typ in zip(ids, vtypes)] if own else vtypes
         slots = trails.slots(ids)
         record_fronts(num, slots, trails.arrays, self.step)
-        vehicles, vtypes = ids, types
+        vehicles, vehicle_types = ids, types
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(rows))
             back = 0.5 * num[:, 5]
@@ -584,19 +595,83 @@ class SumoTraffic(LiveSumo):
         beside = 0.0 if self.settings.edges else BESIDE_DECK
         x, y, v, a, keep = axles_on_path(num, slots, trails.arrays, back, owner, self._axis_frame, self.deck_y,
                                          self._x_range, (0.0, self.axis.length, beside))
-        if self._sideways and not self._sideways.isdisjoint(vtypes):  # wheels beside the path: across the axis
-            left = np.array([side for typ in vtypes for _, side in self._axles[typ]])
+        if self._sideways and not self._sideways.isdisjoint(vehicle_types):  # wheels beside the path: across
+            left = np.array([side for typ in vehicle_types for _, side in self._axles[typ]])
             along = self._unit[0]
             heading = np.radians(num[:, 2])
             ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
             y = y + ahead[owner] * left
+        if self._draws is not None:  # each vehicle's wander within its lane
+            offsets = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in vehicles])
+            y = y + offsets[owner]
+        loads = self._entering(vehicles, vehicle_types, num, owner, x, y)
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]
             x, y, v, a = x[keep], y[keep], v[keep], a[keep]
-        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=v, a=a, types=tuple(types))
+        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=v, a=a, types=tuple(types), loads=loads)
+
+    # ----------------------------------------------------------------- loads
+    def _first_sight(self, vid: str, vtype: str, row: np.ndarray) -> None:
+        """A vehicle seen for the first time: with ``[traffic.loads]``, what it carries (its own vehicle type,
+        class, wander and the loads' source), drawn from the seed and its id; its direction from its heading."""
+        if self._draws is None:
+            return
+        heading = np.radians(row[2])
+        along = self._unit[0]
+        direction = 1 if math.sin(heading) * along[0] + math.cos(heading) * along[1] >= 0.0 else 2
+        draw = self._draws.draw(vid, self.types[vtype], direction)
+        own = draw.vehicle_type
+        if own is not None:
+            columns = own.contact_columns()
+            self._axles[own.id] = tuple((back, left) for _, _, back, left in columns)
+            if any(left for _, left in self._axles[own.id]):
+                self._sideways.add(own.id)
+            self._known({key: model for key, model, _, _ in columns})
+            self._own[vid] = own
+        self._label[vid] = (draw.vehicle_class, draw.wander, draw.source)
+
+    def _entering(self, vehicles: list[str], types: list[str], num: np.ndarray, owner: np.ndarray, x: np.ndarray,
+                  y: np.ndarray) -> tuple[LoadRecord, ...]:
+        """The load records of the vehicles whose first contact point came onto the deck in this step: class,
+        weights, axles, the lane it drives on (SUMO's), its speed, path and wander, and the loads' source."""
+        on = (x >= 0.0) & (x <= self.axis.length)
+        if not on.any():
+            return ()
+        out = []
+        for r in dict.fromkeys(owner[on].tolist()):
+            vid = vehicles[r]
+            if vid in self._recorded:
+                continue
+            self._recorded.add(vid)
+            vtype = self._own.get(vid) or self.types[types[r]]
+            label, offset, source = self._label.get(vid, (vtype.vclass, 0.0, f"vType {vtype.id}: "
+                                                                             f"{vtype.sources.get('mass', '')}"))
+            try:
+                lane = str(self.libsumo.vehicle.getLaneID(vid))
+            except Exception:  # noqa: BLE001 - no lane to be had: the record says so
+                lane = ""
+            weight = vtype.mass * LOADS_G
+            distances = [d for d, _ in vtype.axles]
+            first = int(np.flatnonzero(owner == r)[0])
+            out.append(LoadRecord(id=vid, vehicle_class=label, lane=lane, speed=float(num[r, 3]), gvw=weight,
+                                  axle_loads=tuple(share * weight for _, share in vtype.axles),
+                                  axle_spacings=tuple(b - a for a, b in zip(distances, distances[1:])),
+                                  y=float(y[first]), wander=offset, source=source))
+        return tuple(out)
+
+    def _forget(self, vid: str) -> None:
+        """A vehicle no longer followed: its trail, its own vehicle type and its record's bookkeeping go."""
+        assert self._trails is not None
+        self._trails.drop(vid)
+        own = self._own.pop(vid, None)
+        if own is not None:
+            self._axles.pop(own.id, None)
+            self._sideways.discard(own.id)
+        self._label.pop(vid, None)
+        self._recorded.discard(vid)
 
     def _seed_trail(self, vid: str, row: np.ndarray) -> None:
         """A vehicle seen for the first time: its trail starts with its lane behind its bumper (a vehicle
@@ -636,8 +711,7 @@ class SumoTraffic(LiveSumo):
             vid = ids[i]
             self._done.add(vid)
             self._watched.discard(vid)
-            if self._trails is not None:
-                self._trails.drop(vid)
+            self._forget(vid)
             try:
                 self.libsumo.vehicle.unsubscribe(vid)
             except Exception:  # noqa: BLE001 - nothing to undo

@@ -36,11 +36,15 @@ from __future__ import annotations
 import difflib
 import math
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 from cosim.core.vehicles import LIBRARY, MODELS, ModelSpec, TyreQuarterCar, VehicleModel, VTypeInputs
 from cosim.core.vehicles.registry import cell
 from cosim.errors import ConfigError, SumoError
 from cosim.sumo.library import LibraryVehicle, Suspension, entry_for
+
+if TYPE_CHECKING:
+    from cosim.core.loads import VehicleLoad
 
 __all__ = [
     "HEAVY_VCLASSES",
@@ -384,6 +388,35 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
             raise SumoError(f"vType {type_id}: {exc}") from None
     return VehicleType(id=type_id, vclass=vclass, length=float(length), model=model, axles=axles,
                        sources=sources, details=details, library=entry.name, note=note)
+
+
+def loaded_vehicle_type(vtype: VehicleType, key: str, load: VehicleLoad, front: float, source: str) -> VehicleType:
+    """One vehicle of ``vtype`` with its own drawn loads (``load``: a :class:`cosim.core.loads.VehicleLoad`):
+    its axles ``front`` m behind the bumper and then at the drawn spacings, each carrying its drawn load, on the
+    vType's suspension scaled to the drawn weight (the same frequencies and damping ratios), named ``key``.
+
+    Raises:
+        SumoError: the vType's model is one body on its axles (a half-car): its loads are its own.
+    """
+    if vtype.model.contacts > 1:
+        raise SumoError(f"vType {vtype.id}: a half-car's weights come from its own params; map it to \"fixed\" "
+                        "in [traffic.loads] vtype_classes")
+    mass = load.gross_weight / LOADS_G
+    model = vtype.model.scaled(mass / vtype.mass)
+    distances = [front]
+    for spacing in load.axle_spacings:
+        distances.append(distances[-1] + spacing)
+    shares = [w / load.gross_weight for w in load.axle_loads]
+    return VehicleType(id=key, vclass=vtype.vclass, length=vtype.length, model=model,
+                       axles=tuple(zip(distances, shares)),
+                       sources={"mass": source, "axles": source, "suspension": vtype.sources.get("suspension", "")},
+                       details={"mass": f"drawn for this vehicle from {source}", "axles": f"drawn from {source}",
+                                "suspension": f"the vType {vtype.id}'s, scaled to the drawn weight"},
+                       library=vtype.library, note=vtype.note)
+
+
+#: Gravity of the WIM models' weights, m/s^2 (BTLS's, :data:`cosim.core.loads.draws.G`).
+LOADS_G = 9.81
 
 
 def _library_axles(entry: LibraryVehicle, length: float) -> tuple[tuple[tuple[float, float], ...], bool]:
