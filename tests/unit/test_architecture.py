@@ -1,9 +1,10 @@
 """The layout is the architecture: these tests keep it true (docs/architecture.md).
 
 Layers, from the bottom: ``cosim.errors``; the numerical core ``cosim.core``
-(numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo`` and
-``cosim.log``, the drawing module ``cosim.plots`` and the engineering analyses
-``cosim.analysis`` (fatigue, extremes); orchestration
+(numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo``,
+``cosim.log`` and ``cosim.bridges`` (modes files and importers), the drawing
+module ``cosim.plots`` and the engineering analyses ``cosim.analysis``
+(fatigue, extremes); orchestration
 ``cosim.run``; ``cosim.study`` and ``cosim.validation`` on top of it; the
 scenario-testing API ``cosim.testing``; the command line ``cosim.cli``.
 Dependencies point down only, modules of one layer do not import each other
@@ -33,6 +34,7 @@ LAYERS = {
     "cosim.core": 1,
     "cosim.sumo": 2,
     "cosim.log": 2,
+    "cosim.bridges": 2,
     "cosim.plots": 2,
     "cosim.analysis": 2,
     "cosim.run": 3,
