@@ -6,6 +6,8 @@ frequencies, mass-normalised vertical mode shapes, and the contact
 interpolation of docs/theory.md §13). This package makes one:
 
 - :func:`read_modes`, :func:`write_modes`: a ``.npz`` file or a folder of CSV files;
+- :func:`from_opensees`: the modes of an OpenSeesPy model built in this process (OpenSeesPy is imported
+  there, and only there: it is never a dependency of cosim);
 - :func:`from_beam`: the beam model's own modes (a beam scenario on the modal route).
 
 An adapter over the core, like :mod:`cosim.sumo` and :mod:`cosim.log` (layer 2 of docs/architecture.md).
@@ -16,5 +18,6 @@ from cosim.core.modal_deck import ModalDeck
 
 from .beam import from_beam
 from .files import read_modes, write_modes
+from .opensees import from_opensees, generalised_masses
 
-__all__ = ["ModalDeck", "from_beam", "read_modes", "write_modes"]
+__all__ = ["ModalDeck", "from_beam", "from_opensees", "generalised_masses", "read_modes", "write_modes"]
