@@ -20,7 +20,7 @@ any field that is cubic per cell along ``s`` with the given slopes and cubic
 across: a beam's modes imported by :func:`cosim.bridges.from_beam` (cubic
 per element, linear across: ``w = w_S + (y - y_S) theta_x``) are reproduced to
 round-off. Points that are not a tensor grid (an unstructured shell mesh) are
-resampled once onto one by scipy's C1 Clough-Tocher interpolant.
+fitted once by a least-squares bicubic spline, whose knot cells are the grid.
 
 The evaluation (:func:`grid_rows`, :func:`contact_rows`) is compiled with numba
 and takes plain arrays, so that the coupled step can inline it.
@@ -48,8 +48,6 @@ __all__ = ["DeckGrid", "GRID_TOLERANCE", "build_grid", "contact_rows", "grid_row
 #: Points within this share of the deck's extent of a grid line lie on it (a structured grid from a file
 #: written with 6-7 significant digits is still one).
 GRID_TOLERANCE = 1e-5
-#: A resampling grid has at most this many nodes per deck point (it adds no information, only resolution).
-RESAMPLE_NODES_PER_POINT = 4
 
 Array = npt.NDArray[np.float64]
 
@@ -185,7 +183,7 @@ def _grid(origin: Array, axis: Array, s_knots: Array, r_knots: Array, w: Array, 
 def build_grid(points: Array, frame: str, phi: Array, phi_x: Array | None = None,
                phi_x_minus: Array | None = None, where: str = "") -> tuple[DeckGrid, str, bool]:
     """The interpolation grid of a deck's modes, a sentence that says how it was made, and whether the points
-    are its nodes (a structured grid) rather than resampled onto it.
+    are its nodes (a structured grid) rather than fitted by it.
 
     Args:
         points: (n, 2) the deck points in the deck's frame, m.
@@ -230,8 +228,8 @@ def build_grid(points: Array, frame: str, phi: Array, phi_x: Array | None = None
         note = (f"a structured grid of {ns} x {nr} points: cubic Hermite along the deck with {how}, "
                 f"cubic spline across")
         return _grid(origin, axis, s_knots, r_knots, on_grid(phi), slopes, behind), note, True
-    resampled, note = _resampled(points, frame, axes[0], origin, phi, phi_x is not None, where)
-    return resampled, note, False
+    fitted, note = _fitted(points, frame, axes[0], origin, phi, phi_x is not None, where)
+    return fitted, note, False
 
 
 #: Knots of the least-squares spline of scattered points every this many point spacings (docs/theory.md §13.4).
@@ -260,8 +258,8 @@ def _row_products(a: sp.csr_matrix, b: sp.csr_matrix) -> sp.csr_matrix:
     return sp.csr_matrix((vals, (rows, cols)), shape=(a.shape[0], a.shape[1] * b.shape[1]))
 
 
-def _resampled(points: Array, frame: str, axis: Array, origin: Array, phi: Array, had_slopes: bool,
-               where: str) -> tuple[DeckGrid, str]:
+def _fitted(points: Array, frame: str, axis: Array, origin: Array, phi: Array, had_slopes: bool,
+            where: str) -> tuple[DeckGrid, str]:
     """Scattered points: the least-squares bicubic spline of their values, with knots every
     :data:`KNOTS_PER_SPACING` point spacings and a light curvature penalty (it fills the knot cells the
     points leave empty, beyond their hull, smoothly), written at its knots (docs/theory.md §13.4)."""

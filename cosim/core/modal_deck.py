@@ -187,7 +187,7 @@ class ModalDeck:
 
     @property
     def interpolation(self) -> str:
-        """How the grid was made, one sentence (a structured grid, or scattered points resampled)."""
+        """How the grid was made, one sentence (a structured grid, or scattered points fitted)."""
         return self._interpolation[1]
 
     @cached_property
@@ -248,7 +248,7 @@ class ModalDeck:
     # ----------------------------------------------------------------------------------------- sensors
     def sensor_row(self, sensor: Sensor) -> Array:
         """The (m,) modal row a sensor reads (apply it to the modal coordinates, their rate or acceleration as
-        :data:`cosim.core.sensors.TIME_DERIVATIVE` says).
+        :data:`cosim.core.sensors.TIME_DERIVATIVE` says); the sensor's (x, y) are in the deck's frame.
 
         Raises:
             ConfigError: naming the sensor: a deck point off the deck's surface; a quantity the modes cannot
