@@ -17,7 +17,7 @@ import numpy.typing as npt
 
 from .jit import compiled
 
-__all__ = ["BARYCENTRIC_TOLERANCE", "TriangleIndex", "inside_triangles", "triangle_index"]
+__all__ = ["BARYCENTRIC_TOLERANCE", "TriangleIndex", "inside_triangles", "point_in_triangles", "triangle_index"]
 
 #: A point whose barycentric coordinates are all >= -this lies in the triangle (its edges included).
 BARYCENTRIC_TOLERANCE = 1e-9
@@ -100,35 +100,36 @@ def _in_triangle(points: np.ndarray, tri: np.ndarray, px: float, py: float) -> b
     return la >= tol and lb >= tol and lc >= tol
 
 
-@compiled
-def _inside(points: np.ndarray, triangles: np.ndarray, lo: np.ndarray, size: float, shape: np.ndarray,
-            start: np.ndarray, items: np.ndarray, x: np.ndarray, y: np.ndarray, out: np.ndarray) -> None:
+@compiled(inline=True)
+def point_in_triangles(points: np.ndarray, triangles: np.ndarray, lo: np.ndarray, size: float, shape: np.ndarray,
+                       start: np.ndarray, items: np.ndarray, x: float, y: float) -> bool:
+    """Whether (x, y) lies in one of a :class:`TriangleIndex`'s triangles (its arrays, in its order): the
+    compiled test of one point, for the coupled step to inline."""
     # a point on a bucket's edge may sit in a triangle listed in the next bucket only: look in the buckets
     # within the barycentric tolerance's reach too (the point's bucket, and its neighbours if that close)
     reach = 1e-9 * size
+    fx = (x - lo[0]) / size
+    fy = (y - lo[1]) / size
+    if not (fx >= -reach and fy >= -reach and fx <= shape[0] + reach and fy <= shape[1] + reach):
+        return False
+    bx0 = min(max(int(math.floor(fx - reach)), 0), shape[0] - 1)
+    bx1 = min(max(int(math.floor(fx + reach)), 0), shape[0] - 1)
+    by0 = min(max(int(math.floor(fy - reach)), 0), shape[1] - 1)
+    by1 = min(max(int(math.floor(fy + reach)), 0), shape[1] - 1)
+    for bx in range(bx0, bx1 + 1):
+        for by in range(by0, by1 + 1):
+            b = bx * shape[1] + by
+            for q in range(start[b], start[b + 1]):
+                if _in_triangle(points, triangles[items[q]], x, y):
+                    return True
+    return False
+
+
+@compiled
+def _inside(points: np.ndarray, triangles: np.ndarray, lo: np.ndarray, size: float, shape: np.ndarray,
+            start: np.ndarray, items: np.ndarray, x: np.ndarray, y: np.ndarray, out: np.ndarray) -> None:
     for p in range(len(x)):
-        out[p] = False
-        fx = (x[p] - lo[0]) / size
-        fy = (y[p] - lo[1]) / size
-        if not (fx >= -reach and fy >= -reach and fx <= shape[0] + reach and fy <= shape[1] + reach):
-            continue
-        bx0 = min(max(int(math.floor(fx - reach)), 0), shape[0] - 1)
-        bx1 = min(max(int(math.floor(fx + reach)), 0), shape[0] - 1)
-        by0 = min(max(int(math.floor(fy - reach)), 0), shape[1] - 1)
-        by1 = min(max(int(math.floor(fy + reach)), 0), shape[1] - 1)
-        found = False
-        for bx in range(bx0, bx1 + 1):
-            for by in range(by0, by1 + 1):
-                b = bx * shape[1] + by
-                for q in range(start[b], start[b + 1]):
-                    if _in_triangle(points, triangles[items[q]], x[p], y[p]):
-                        found = True
-                        break
-                if found:
-                    break
-            if found:
-                break
-        out[p] = found
+        out[p] = point_in_triangles(points, triangles, lo, size, shape, start, items, x[p], y[p])
 
 
 def inside_triangles(index: TriangleIndex, x: npt.ArrayLike, y: npt.ArrayLike) -> npt.NDArray[np.bool_]:
