@@ -93,5 +93,16 @@ MAX_RECORD_BYTES = Limit("COSIM_MAX_RECORD_BYTES", 64 * 1024 * 1024, "bytes", "o
 #: Records (vehicles) of one WIM record file: streamed in constant memory, so this bounds the time a file takes.
 MAX_WIM_RECORDS = Limit("COSIM_MAX_WIM_RECORDS", 200_000_000, "records", "one WIM record file")
 
+#: Points of a deck given by its modes (a modes file, an importer; docs/modal-decks.md).
+MAX_DECK_POINTS = Limit("COSIM_MAX_DECK_POINTS", 200_000, "points", "the deck points of a modal deck")
+#: Modes of a deck given by its modes.
+MAX_DECK_MODES = Limit("COSIM_MAX_DECK_MODES", 5_000, "modes", "the modes of a modal deck")
+#: Numbers of one array of a modal deck (modes x points), and of its interpolation grid (modes x grid nodes).
+MAX_MODE_VALUES = Limit("COSIM_MAX_MODE_VALUES", 20_000_000, "values",
+                        "one array of a modal deck (modes x points, or modes x interpolation nodes)")
+#: Bytes of a modes file (the .npz, or each file of the CSV form).
+MAX_MODES_FILE_BYTES = Limit("COSIM_MAX_MODES_FILE_BYTES", 1024 * 1024 * 1024, "bytes", "a modes file")
+
 ALL_LIMITS: tuple[Limit, ...] = (MAX_DOFS, MAX_SECTION_TRIANGLES, MAX_ROAD_POINTS, MAX_ROAD_FILE_BYTES, MAX_STEPS,
-                                 MAX_RUNS, MAX_CHUNK_BYTES, MAX_ATTACHMENT_BYTES, MAX_RECORD_BYTES, MAX_WIM_RECORDS)
+                                 MAX_RUNS, MAX_CHUNK_BYTES, MAX_ATTACHMENT_BYTES, MAX_RECORD_BYTES, MAX_WIM_RECORDS,
+                                 MAX_DECK_POINTS, MAX_DECK_MODES, MAX_MODE_VALUES, MAX_MODES_FILE_BYTES)

@@ -1,9 +1,10 @@
 """The layout is the architecture: these tests keep it true (docs/architecture.md).
 
 Layers, from the bottom: ``cosim.errors``; the numerical core ``cosim.core``
-(numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo`` and
-``cosim.log``, the drawing module ``cosim.plots`` and the engineering analyses
-``cosim.analysis`` (fatigue, extremes); orchestration
+(numpy, scipy, numba, sectionproperties); the adapters ``cosim.sumo``,
+``cosim.log`` and ``cosim.bridges`` (modes files and importers), the drawing
+module ``cosim.plots`` and the engineering analyses ``cosim.analysis``
+(fatigue, extremes); orchestration
 ``cosim.run``; ``cosim.study`` and ``cosim.validation`` on top of it; the
 scenario-testing API ``cosim.testing``; the command line ``cosim.cli``.
 Dependencies point down only, modules of one layer do not import each other
@@ -33,6 +34,7 @@ LAYERS = {
     "cosim.core": 1,
     "cosim.sumo": 2,
     "cosim.log": 2,
+    "cosim.bridges": 2,
     "cosim.plots": 2,
     "cosim.analysis": 2,
     "cosim.run": 3,
@@ -282,6 +284,31 @@ def test_no_module_reads_another_modules_or_packages_private_names():
             if private and name not in PUBLIC_UNDERSCORE and (_relative(path), name) not in ISOLATED_PRIVATE_READS:
                 problems.append(f"{_relative(path)}:{line}: {name}")
     assert not problems, "private names of other modules or packages:\n" + "\n".join(problems)
+
+
+#: The one function that imports OpenSeesPy: a user's tool and a test oracle, never a dependency of cosim
+#: (docs/modal-decks.md); it reads the model the user has built in the running process.
+OPENSEES_IMPORTER = ("cosim/bridges/opensees.py", "_ops")
+
+
+def test_openseespy_is_imported_by_the_opensees_importer_only_and_inside_a_function():
+    problems, found = [], 0
+    for path in _modules().values():
+        for where, node in _nodes_by_function(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                names = [node.module or ""]
+            else:
+                continue
+            if not any(n.split(".")[0] in ("openseespy", "opensees") for n in names):
+                continue
+            if (_relative(path), where) == OPENSEES_IMPORTER:
+                found += 1
+            else:
+                problems.append(f"{_relative(path)}:{node.lineno} ({where or 'module'}): imports {', '.join(names)}")
+    assert not problems, f"OpenSeesPy imported outside {OPENSEES_IMPORTER}:\n" + "\n".join(problems)
+    assert found == 1, f"{OPENSEES_IMPORTER} does not import OpenSeesPy: update OPENSEES_IMPORTER"
 
 
 # --------------------------------------------------------------------------- citations
