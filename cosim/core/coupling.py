@@ -281,6 +281,11 @@ class CoupledSystem:
         self._engine = name
 
     @property
+    def factorizations(self) -> int:
+        """Effective-matrix factorisations done (by the basis)."""
+        return self.basis.n_factorizations
+
+    @property
     def liftoff_events(self) -> int:
         """How many times a wheel on the deck started to pull (contact force < 0)."""
         return int(self._counters[0])

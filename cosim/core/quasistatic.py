@@ -25,13 +25,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from cosim.errors import ConfigError
+
 from .bridge import BridgeModel
-from .sensors import Sensor, sensor_row
-from .traffic import TrafficSource, vehicle_of
+from .coupling import BlockReport
+from .sensors import Sensor, check_sensor_on, sensor_row
+from .traffic import AXLE_SEPARATOR, TrafficBlock, TrafficSource, vehicle_of
 
 #: Sensor quantities that have a quasi-static response (and hence a DAF).
 STATIC_QUANTITIES = ("displacement", "bending_moment", "stress", "strain", "shear_stress_xy", "shear_stress_xz")
@@ -96,6 +100,47 @@ class QuasiStaticResult:
     steps: int = 0
 
 
+def column_weights(ids: tuple[str, ...], models: tuple[Any, ...], gravity: float) -> npt.NDArray[np.float64]:
+    """Each contact column's static load, N (compression positive): a one-contact model's weight; column k of a
+    vehicle on several contacts (``id#k`` of one body) that body's k-th static axle load."""
+    out = np.empty(len(models))
+    cache: dict[int, np.ndarray] = {}
+    for j, (cid, model) in enumerate(zip(ids, models)):
+        if model.contacts == 1:
+            out[j] = model.total_mass * gravity
+            continue
+        loads = cache.get(id(model))
+        if loads is None:
+            loads = cache[id(model)] = np.asarray(model.static_axle_loads(gravity), dtype=float)
+        k = int(cid.rsplit(AXLE_SEPARATOR, 1)[1]) if AXLE_SEPARATOR in cid else 0
+        out[j] = loads[k]
+    return out
+
+
+def static_block(bridge: BridgeModel, g: npt.NDArray[np.float64], block: TrafficBlock, gravity: float,
+                 y_range: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The static response of a block of traffic: sensor values (K, s), and per contact column (K, q) on the
+    deck (its length and its surface), its static load there (N; 0 elsewhere) and beside the surface over the
+    deck's length (it loads nothing there). ``g``: the sensors' influence vectors (NaN rows as 0)."""
+    k, q = block.x.shape
+    values = np.zeros((k, len(g)))
+    if not q:
+        empty = np.zeros((k, 0), dtype=bool)
+        return values, empty, np.zeros((k, 0)), empty
+    span = (block.x >= 0.0) & (block.x <= bridge.length)
+    surface = (block.y >= y_range[0]) & (block.y <= y_range[1])
+    on = span & surface[None, :]
+    weight = column_weights(block.ids, block.models, gravity)
+    force = np.where(on, weight[None, :], 0.0)
+    rows, cols = np.nonzero(on)
+    if len(rows) and len(g):
+        ordinates = influence(bridge, g, block.x[rows, cols], block.y[cols])  # (s, p)
+        contrib = -weight[cols][None, :] * ordinates  # the weight acts downwards
+        for s in range(len(g)):
+            values[:, s] = np.bincount(rows, weights=contrib[s], minlength=k)
+    return values, on, force, span & ~surface[None, :]
+
+
 def quasi_static(
     bridge: BridgeModel,
     traffic: TrafficSource,
@@ -110,8 +155,8 @@ def quasi_static(
 
     The traffic is asked for the same times as :func:`cosim.core.simulation.simulate`
     asks (``k dt``, k = 1 ... round(duration / dt)), so the vehicles stand exactly
-    where they stood in the dynamic run. Each vehicle on the deck loads it with
-    ``total_mass * gravity`` downwards.
+    where they stood in the dynamic run. Each contact point on the deck loads it with
+    its static load downwards (:func:`column_weights`).
 
     Args:
         bridge: the structural model (its stiffness only).
@@ -127,44 +172,37 @@ def quasi_static(
     g = np.where(np.isnan(g), 0.0, g)
     names = [s.name for s in sensors]
     n_steps = int(round(duration / dt))
-    length = bridge.length
     peak = np.zeros(len(sensors))
     kept_t: list[np.ndarray] = [np.zeros(1)]
     kept_s: list[np.ndarray] = [np.zeros((1, len(sensors)))]
     seen: dict[str, None] = {}
     heaviest, heaviest_id, max_on = 0.0, "", 0
+    everywhere = (-np.inf, np.inf)
     done = 0
     while done < n_steps:
         k = min(block_steps, n_steps - done)
         steps = np.arange(done + 1, done + k + 1)
         times = steps * dt
         block = traffic.block(times)
-        q = len(block.ids)
-        values = np.zeros((k, len(sensors)))
-        if q:
-            on = (block.x >= 0.0) & (block.x <= length)
-            mass = np.array([m.total_mass for m in block.models], dtype=float)
-            weight = mass * gravity
+        values, on, _, _ = static_block(bridge, g, block, gravity, everywhere)
+        if on.any():
+            # Vehicles, not contact points: the axles of one vehicle ("id#k") count once, masses add up.
             rows, cols = np.nonzero(on)
-            if len(rows):
-                ordinates = influence(bridge, g, block.x[rows, cols], block.y[cols])  # (s, p)
-                contrib = -weight[cols][None, :] * ordinates  # downward weight
-                for s in range(len(sensors)):
-                    values[:, s] = np.bincount(rows, weights=contrib[s], minlength=k)
-                # Vehicles, not contact points: the axles of one vehicle ("id#k") count once, masses add up.
-                owner = np.array([vehicle_of(v) for v in block.ids])
-                names_u, col_owner = np.unique(owner, return_inverse=True)
-                on_vehicle = np.zeros((k, len(names_u)), dtype=bool)
-                on_vehicle[rows, col_owner[cols]] = True
-                max_on = max(max_on, int(on_vehicle.sum(axis=1).max()))
-                present = np.flatnonzero(on.any(axis=0))
-                vehicle_mass = np.bincount(col_owner, weights=mass, minlength=len(names_u))
-                for j in present:
-                    seen.setdefault(owner[j], None)
-                u = np.unique(col_owner[present])
-                u_max = u[int(np.argmax(vehicle_mass[u]))]
-                if vehicle_mass[u_max] > heaviest:
-                    heaviest, heaviest_id = float(vehicle_mass[u_max]), str(names_u[u_max])
+            owner = np.array([vehicle_of(v) for v in block.ids])
+            names_u, col_owner = np.unique(owner, return_inverse=True)
+            on_vehicle = np.zeros((k, len(names_u)), dtype=bool)
+            on_vehicle[rows, col_owner[cols]] = True
+            max_on = max(max_on, int(on_vehicle.sum(axis=1).max()))
+            present = np.flatnonzero(on.any(axis=0))
+            mass = column_weights(block.ids, block.models, gravity) / gravity if gravity > 0 else \
+                np.array([m.total_mass for m in block.models])
+            vehicle_mass = np.bincount(col_owner, weights=mass, minlength=len(names_u))
+            for j in present:
+                seen.setdefault(owner[j], None)
+            u = np.unique(col_owner[present])
+            u_max = u[int(np.argmax(vehicle_mass[u]))]
+            if vehicle_mass[u_max] > heaviest:
+                heaviest, heaviest_id = float(vehicle_mass[u_max]), str(names_u[u_max])
         if len(sensors):
             peak = np.maximum(peak, np.abs(values).max(axis=0))
         keep = steps % output_every == 0
@@ -181,6 +219,51 @@ def quasi_static(
     )
 
 
+class QuasiStaticSystem:
+    """The deck's static response at every step of a run, block by block (``[solver] method = "quasi-static"``):
+    the same interface as :class:`cosim.core.coupling.CoupledSystem` for :func:`cosim.core.simulation.simulate`.
+
+    Each contact point on the deck presses with its static load (:func:`column_weights`); sensors read the
+    static response by reciprocity (:func:`influence`). No inertia, no vehicle dynamics, no road roughness: the
+    contact force is the static load, the bodies do not move.
+
+    Raises:
+        ConfigError: a sensor whose quantity has no static counterpart (velocity, acceleration).
+    """
+
+    def __init__(self, bridge: BridgeModel, sensors: tuple[Sensor, ...], gravity: float) -> None:
+        for sensor in sensors:
+            if sensor.quantity not in STATIC_QUANTITIES:
+                raise ConfigError(f"sensor {sensor.name}: quantity = {sensor.quantity!r} has no quasi-static value "
+                                  f"(only {', '.join(STATIC_QUANTITIES)}); remove the sensor or use "
+                                  "method = \"dynamic\"")
+            check_sensor_on(bridge, sensor)
+        self.bridge, self.sensors, self.gravity = bridge, sensors, float(gravity)
+        self._g = influence_vectors(bridge, sensors)
+        y_min, y_max = bridge.section.deck_y
+        tol = 1e-9 * max(y_max - y_min, 1.0)
+        self._y_range = (y_min - tol, y_max + tol)
+        self.n_steps = 0
+        self.factorizations = 1  # the stiffness, once, for the sensors' influence vectors
+        self.liftoff_events = self.liftoff_steps = 0
+        self.offdeck_events = self.offdeck_steps = 0
+        self._off: dict[str, bool] = {}
+
+    def advance(self, block: TrafficBlock) -> BlockReport:
+        """The static response at the block's steps, as a :class:`cosim.core.coupling.BlockReport`."""
+        values, on, force, off = static_block(self.bridge, self._g, block, self.gravity, self._y_range)
+        k, q = block.x.shape
+        if off.any():
+            before = np.array([self._off.get(i, False) for i in block.ids])
+            self.offdeck_events += int((np.diff(np.vstack([before[None, :], off]).astype(np.int8), axis=0) > 0).sum())
+            self.offdeck_steps += int(off.sum())
+        self._off = {block.ids[j]: bool(off[-1, j]) for j in range(q) if off[-1, j]} if k else self._off
+        self.n_steps += k
+        zeros = np.zeros((k, q))
+        return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, on, force, zeros, zeros,
+                           values, np.zeros((k, q), dtype=bool), off, block.loads)
+
+
 def daf(dynamic_peak: float, static_peak: float) -> float:
     """Dynamic amplification factor ``dynamic_peak / static_peak`` (NaN when the static peak is 0 or NaN)."""
     if not np.isfinite(static_peak) or static_peak <= 0.0:
@@ -188,4 +271,5 @@ def daf(dynamic_peak: float, static_peak: float) -> float:
     return float(dynamic_peak) / float(static_peak)
 
 
-__all__ = ["QuasiStaticResult", "STATIC_QUANTITIES", "daf", "influence", "influence_vectors", "quasi_static"]
+__all__ = ["QuasiStaticResult", "STATIC_QUANTITIES", "column_weights", "daf", "influence", "influence_vectors",
+           "QuasiStaticSystem", "quasi_static", "static_block"]

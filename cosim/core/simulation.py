@@ -32,6 +32,7 @@ from .checks import finite, one_of
 from .coupling import BlockReport, CoupledSystem
 from .fields import VEHICLE_NUMBERS
 from .jit import compiled
+from .quasistatic import QuasiStaticSystem
 from .roughness import RoadProfile
 from .schemes import Scheme
 from .sensors import Sensor
@@ -39,6 +40,9 @@ from .traffic import TrafficBlock, TrafficSource, vehicle_of
 
 SCHEMES: tuple[str, ...] = ("newmark", "hht")
 BASES: tuple[str, ...] = ("direct", "modal")
+#: How the deck answers its loads: in time, with inertia and the vehicles' dynamics (the coupled step), or the
+#: static response at every step (no inertia, no vehicle dynamics, no roughness: docs/theory.md §7.4).
+METHODS: tuple[str, ...] = ("dynamic", "quasi-static")
 #: The interpreter's thread switch interval while a run overlaps traffic and solver, s. At Python's default
 #: (5 ms) the solver thread waited that long for the GIL to leave its compiled loop while the traffic thread
 #: (SUMO, the adapter) ran Python: the two threads took turns instead of overlapping (benchmarks/results/).
@@ -51,7 +55,8 @@ VEHICLE_COLUMNS: tuple[str, ...] = ("t", "vehicle", *VEHICLE_NUMBERS)
 
 @dataclass(frozen=True)
 class SolverSettings:
-    """Time step (s), scheme (newmark | hht), basis (direct | modal) and modal truncation; gravity, m/s^2.
+    """Time step (s), scheme (newmark | hht), basis (direct | modal) and modal truncation; gravity, m/s^2;
+    ``method``: dynamic or quasi-static (:data:`METHODS`).
 
     Raises:
         ConfigError: a non-finite or non-physical value, or an unknown scheme or basis.
@@ -64,10 +69,12 @@ class SolverSettings:
     modes: int | None = None
     cutoff_hz: float | None = None
     gravity: float = 9.81
+    method: str = "dynamic"
 
     def __post_init__(self) -> None:
         finite(self.dt, "dt", above=0.0)
         finite(self.gravity, "gravity", at_least=0.0)
+        one_of(self.method, METHODS, "method")
         one_of(self.scheme, SCHEMES, "scheme")
         one_of(self.basis, BASES, "basis")
         if self.modes is not None and (isinstance(self.modes, bool) or not isinstance(self.modes, int)
@@ -386,9 +393,16 @@ def simulate(
     if road is not None:
         check_road_covers(bridge, road)
     scheme = solver.make_scheme()
-    basis = make_basis(bridge, solver.dt, scheme, solver.basis, solver.modes, solver.cutoff_hz)
-    system = CoupledSystem(bridge, basis, scheme, solver.dt, road=road, gravity=solver.gravity,
-                           sensors=tuple(sensors))
+    system: CoupledSystem | QuasiStaticSystem
+    if solver.method == "quasi-static":
+        system = QuasiStaticSystem(bridge, tuple(sensors), solver.gravity)
+        info = {"basis": "quasi-static (influence lines)", "n_reduced": len(sensors), "scheme": "none",
+                "dt": solver.dt}
+    else:
+        basis = make_basis(bridge, solver.dt, scheme, solver.basis, solver.modes, solver.cutoff_hz)
+        system = CoupledSystem(bridge, basis, scheme, solver.dt, road=road, gravity=solver.gravity,
+                               sensors=tuple(sensors))
+        info = {"basis": basis.name, "n_reduced": basis.n, "scheme": scheme.name, "dt": solver.dt}
     n_steps = int(round(duration / solver.dt))
     collector = _Collector(len(sensors)) if collect else None
     extremes = _Extremes([s.name for s in sensors])
@@ -477,10 +491,10 @@ def simulate(
         liftoff_steps=system.liftoff_steps,
         offdeck_events=system.offdeck_events,
         offdeck_steps=system.offdeck_steps,
-        factorizations=basis.n_factorizations,
+        factorizations=system.factorizations,
         steps=system.n_steps,
         wall_time=time.perf_counter() - started,
-        info={"basis": basis.name, "n_reduced": basis.n, "scheme": scheme.name, "dt": solver.dt},
+        info=info,
         sensor_min=dict(zip(extremes.names, extremes.s_min.tolist())),
         sensor_max=dict(zip(extremes.names, extremes.s_max.tolist())),
         contact_force_range={k: (v[0], v[1]) for k, v in extremes.force.items()},

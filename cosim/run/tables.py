@@ -31,7 +31,7 @@ from pydantic import (
 from cosim.analysis.fatigue import SNCurve, sn_curve, sn_curve_names
 from cosim.core.roughness import ISO_CLASSES
 from cosim.core.sensors import SECTION_POINT_QUANTITIES, SENSOR_QUANTITIES, Sensor
-from cosim.core.simulation import SolverSettings
+from cosim.core.simulation import METHODS, SolverSettings
 from cosim.core.traffic import ScriptedVehicle
 from cosim.core.vehicles import MODELS, ModelSpec, Parameter, VehicleModel
 from cosim.errors import ConfigError
@@ -518,8 +518,10 @@ class TrafficConfig(ConfigModel):
 
 
 class SolverConfig(ConfigModel):
-    """``[solver]``: time integration settings."""
+    """``[solver]``: time integration settings; ``method``: dynamic, or quasi-static (the static response at
+    every step: no inertia, no vehicle dynamics, no roughness)."""
 
+    method: Annotated[str, choice(METHODS, "method")] = "dynamic"
     dt: Positive = 0.005
     scheme: Annotated[str, choice(SCHEMES, "scheme")] = "newmark"
     hht_alpha: Annotated[float, Strict(), Field(ge=-1.0 / 3.0, le=0.0)] | None = None
@@ -566,6 +568,7 @@ class SolverConfig(ConfigModel):
             modes=self.modes,
             cutoff_hz=self.cutoff_hz,
             gravity=self.gravity,
+            method=self.method,
         )
 
 
