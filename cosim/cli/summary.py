@@ -122,6 +122,19 @@ def _sumo_lines(plan: SumoPlan) -> list[str]:
     vwidth = max([len(t.vclass) for t in types] + [6])
     for t in types:
         lines.append(f"  {t.id:<{width}}  {t.vclass:<{vwidth}}  {t.line()}")
+    loads = plan.settings.loads
+    if loads is not None:
+        from cosim.sumo.loads import VehicleLoads
+
+        draws = VehicleLoads(loads)
+        wander = loads.wander if isinstance(loads.wander, str) else f"normal, sd {fmt_g(loads.wander)} m"
+        lines.append(f"Loads: each vehicle's own, drawn from the {loads.model.name} WIM model (Grave's; "
+                     f"seed {loads.seed}; wander {wander}); per vType:")
+        for t in types:
+            choice = draws.plan(t)
+            what = ("the light (car) distribution" if choice == "car" else "its own weights (above)"
+                    if choice == "fixed" else "trucks of " + " or ".join(str(c) for c in choice) + " axles")
+            lines.append(f"  {t.id:<{width}}  {what}")
     return lines
 
 

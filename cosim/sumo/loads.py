@@ -107,7 +107,7 @@ class VehicleLoads:
         self.settings = settings
         self._classes: dict[str, tuple[int, ...] | str] = {}
 
-    def _plan(self, vtype: VehicleType) -> tuple[int, ...] | str:
+    def plan(self, vtype: VehicleType) -> tuple[int, ...] | str:
         """The vType's choice: truck classes, "car" or "fixed" (worked out once per vType)."""
         plan = self._classes.get(vtype.id)
         if plan is None:
@@ -133,7 +133,7 @@ class VehicleLoads:
         """What vehicle ``vehicle_id`` of ``vtype`` carries, driving in Grave's ``direction`` (1: along the
         bridge axis, 2: against it)."""
         s = self.settings
-        plan = self._plan(vtype)
+        plan = self.plan(vtype)
         offset = s.wander_of(vehicle_id)
         if plan == "fixed":
             return VehicleDraw(None, vtype.vclass, offset, f"vType {vtype.id}: {vtype.sources.get('mass', '')}")

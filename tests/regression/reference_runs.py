@@ -9,7 +9,10 @@ set-up changes the last bits of a few sums)::
 
     COSIM_WRITE_REFERENCE=1 python -m pytest tests/regression
 
-Do not rewrite the logs to make a test pass: they are the "before".
+Do not rewrite the logs to make a test pass: they are the "before". One was rewritten on purpose:
+``paper-bridge-traffic`` (issue 25, 2026-12-03), when the default scenario began to draw each vehicle's
+loads from the Auxerre WIM model (``[traffic.loads]``); its numbers before that are those of the fixed vType
+weights, which ``traffic-40m`` and ``congested-deck`` (the bundled mix without ``[traffic.loads]``) still hold.
 """
 from __future__ import annotations
 
