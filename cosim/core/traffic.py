@@ -106,6 +106,17 @@ class LoadRecord:
     def n_axles(self) -> int:
         return len(self.axle_loads)
 
+    @classmethod
+    def of_model(cls, vehicle_id: str, model: VehicleModel, y: float, speed: float, gravity: float,
+                 source: str = "scripted") -> LoadRecord:
+        """The record of a vehicle whose loads are its model's: its static contact loads at ``gravity`` (m/s^2)
+        and the spacings of its contact points, class the model's name."""
+        loads = tuple(float(v) for v in model.static_axle_loads(gravity))
+        behind = [p.behind for p in model.contact_points]
+        return cls(id=vehicle_id, vehicle_class=model.kind, lane="", speed=float(speed), gvw=float(sum(loads)),
+                   axle_loads=loads, axle_spacings=tuple(b - a for a, b in zip(behind, behind[1:])), y=float(y),
+                   wander=0.0, source=source)
+
 
 @dataclass(frozen=True)
 class TrafficBlock:

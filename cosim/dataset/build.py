@@ -7,7 +7,7 @@ every damage case: paired records); the bridge is the base's with the case's
 stiffness loss and support spring. The run is logged to MCAP, its logged
 histories are measured by the instruments (:func:`~.sensor_models.measure`,
 noise seeded by ``(seed, c, k)``) and become one row of ``dataset.parquet``
-with the labels.
+with the labels (among them each vehicle's loads: ``vehicle_loads``).
 """
 from __future__ import annotations
 
@@ -104,6 +104,16 @@ def _first_vertical_hz(bridge: Any) -> float:
     return float(modal.f_hz[kinds[0]]) if kinds else float("nan")
 
 
+def _vehicle_loads(log: Path) -> list[dict[str, Any]]:
+    """Each vehicle that came onto the deck in a window: its loads as the log records them (``/cosim/vehicle_loads``:
+    t (s), id, class, lane, speed (m/s), gvw (N), axle_loads (N), axle_spacings (m), y and wander (m), source)."""
+    from cosim.log import iter_messages
+    from cosim.log.schemas import TOPIC_VEHICLE_LOADS
+
+    return [{k: v for k, v in message.items() if k != "n_axles"}
+            for _, message in iter_messages(log, [TOPIC_VEHICLE_LOADS])]
+
+
 def write_dataset(dataset: Dataset, *, force: bool = False,
                   progress: Callable[[int, int], None] | None = None) -> DatasetOutcome:
     """Run every window of every damage case and write ``<output>/dataset.parquet`` and the logs.
@@ -143,6 +153,7 @@ def write_dataset(dataset: Dataset, *, force: bool = False,
                 "e_factor": e_factor, "f1_hz": _first_vertical_hz(bridge), "duration": outcome.duration,
                 "vehicles": len(outcome.result.vehicle_ids), "max_on_deck": outcome.result.max_on_deck,
                 "log": str(log.relative_to(dataset.output)),
+                "vehicle_loads": _vehicle_loads(log),
             }
             rows.append(row)
             signals.append({**row, **{f"{n}.rate_hz": s.rate_hz for n, s in zip(names, dataset.sensors)},

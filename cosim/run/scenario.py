@@ -441,7 +441,7 @@ class Scenario(ConfigModel):
     def build_vehicles(self) -> ScriptedTraffic:
         """The scripted vehicles as a :class:`cosim.core.traffic.ScriptedTraffic` on this bridge's length."""
         with self.named("vehicles"):
-            return ScriptedTraffic(tuple(v.to_scripted() for v in self.vehicles), self.bridge.length)
+            return ScriptedTraffic(tuple(v.to_scripted(self.solver.gravity) for v in self.vehicles), self.bridge.length)
 
     def wheel_paths(self) -> tuple[float, ...]:
         """Lateral offsets with a road profile of their own, sorted, m.

@@ -32,7 +32,7 @@ from cosim.analysis.fatigue import SNCurve, sn_curve, sn_curve_names
 from cosim.core.roughness import ISO_CLASSES
 from cosim.core.sensors import SECTION_POINT_QUANTITIES, SENSOR_QUANTITIES, Sensor
 from cosim.core.simulation import METHODS, SolverSettings
-from cosim.core.traffic import ScriptedVehicle
+from cosim.core.traffic import LoadRecord, ScriptedVehicle
 from cosim.core.vehicles import MODELS, ModelSpec, Parameter, VehicleModel
 from cosim.errors import ConfigError
 
@@ -407,16 +407,21 @@ class VehicleConfig(ConfigModel):
                   else value for key, value in self.parameters.items()}
         return spec.build(values, self.contact == "unilateral")
 
-    def to_scripted(self) -> ScriptedVehicle:
-        """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes."""
+    def to_scripted(self, gravity: float = 9.81) -> ScriptedVehicle:
+        """The :class:`cosim.core.traffic.ScriptedVehicle` this table describes (its load record at ``gravity``,
+        m/s^2: what the log records of it at its entry)."""
+        model = self.to_model()
+        speed = self.speed if self.speed is not None else 0.0
+        entry_speed = self.profile[0][1] if self.profile else speed
         return ScriptedVehicle(
             id=self.id,
-            model=self.to_model(),
+            model=model,
             y=self.y,
-            speed=self.speed if self.speed is not None else 0.0,
+            speed=speed,
             entry_time=self.entry_time,
             direction=DIRECTIONS[self.direction],
             profile=self.profile or (),
+            load=LoadRecord.of_model(self.id, model, self.y, entry_speed, gravity),
         )
 
 

@@ -70,7 +70,8 @@ def base_row(task: RunTask) -> dict[str, Any]:
 def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: Sequence[float],
                    vehicles_per_year: float | None = None) -> dict[str, Any]:
     """Peaks, percentiles, RMS, quasi-static peak and DAF per sensor; fatigue of the stress sensors with an S-N
-    curve; vehicle counts of the run.
+    curve; vehicle counts of the run; gross weights per vehicle class (``gvw.<class>.count``, ``.mean``,
+    ``.sd``, ``.max``, N).
 
     Args:
         scenario, bridge: what ran.
@@ -111,6 +112,11 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"{name}.damage_per_year"] = per_year
         row[f"{name}.equivalent_stress_range"] = fat.equivalent_stress_range
         row[f"{name}.max_stress_range"] = fat.max_stress_range
+    for cls, w in result.weights.items():  # gross weights per vehicle class (its loads' records)
+        row[f"gvw.{cls}.count"] = w.count
+        row[f"gvw.{cls}.mean"] = w.mean
+        row[f"gvw.{cls}.sd"] = w.sd
+        row[f"gvw.{cls}.max"] = w.high
     row.update({
         "vehicles": len(result.vehicle_ids),
         "max_on_deck": result.max_on_deck,
