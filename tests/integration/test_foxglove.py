@@ -160,7 +160,7 @@ def test_cosim_layout_never_replaces_a_file_silently_nor_the_log(cars: Path, tmp
     assert missing.returncode == 2 and not (tmp_path / "new.json").exists()
 
 
-@pytest.mark.parametrize("name", ["paper-double-tee", "paper-bridge-traffic"])
+@pytest.mark.parametrize("name", ["paper-double-tee", "paper-bridge-traffic-fixed-weights"])
 def test_logs_written_before_layouts_get_one(name: str, tmp_path: Path) -> None:
     log = REGRESSION_LOGS / f"{name}.mcap"
     assert LAYOUT_ATTACHMENT not in open_log(log).attachments

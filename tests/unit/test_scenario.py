@@ -378,7 +378,7 @@ MALFORMED = [
     pytest.param(
         replaced("dt = 0.005", "dt = 0.005\nrho_inf = 0.8"),
         "solver.rho_inf",
-        ["unknown key", "expected one of: dt, scheme, hht_alpha, basis, modes, cutoff_hz, duration, gravity"],
+        ["unknown key", "expected one of: method, dt, scheme, hht_alpha, basis, modes, cutoff_hz, duration, gravity"],
         id="rho-inf-not-implemented",
     ),
     pytest.param(
