@@ -19,6 +19,7 @@ from .banded import upper_band
 from .bridge import BridgeModel
 from .element import DeckRow
 from .kernels import DIRECT, MODAL, BasisArrays
+from .modal_bridge import ModalBridge
 from .schemes import Scheme
 
 _EMPTY_1 = np.zeros(0)
@@ -276,18 +277,70 @@ class ModalBasis(_Counts):
         return float(0.5 * v @ v + 0.5 * d @ (self.k_diag * d))
 
 
+class DeckModalBasis(_Counts):
+    """The modes of a deck given by its modes (:class:`cosim.core.modal_bridge.ModalBridge`): the same diagonal
+    Newmark/HHT operator as :class:`ModalBasis`, each mode damped by its own ratio (``c = 2 zeta omega``).
+    Contact and sensor rows come from the deck's surface in modal coordinates, so there is no DOF vector to
+    project from (``phi`` is empty in the kernel's arrays)."""
+
+    name = "modal"
+
+    def __init__(self, bridge: ModalBridge, dt: float, scheme: Scheme) -> None:
+        self.bridge, self.dt, self.scheme = bridge, float(dt), scheme
+        self.omega = np.array(bridge.omega, dtype=float)
+        self.n = int(bridge.n_modes)
+        self.c_diag = 2.0 * bridge.zeta * self.omega
+        self.k_diag = self.omega**2
+        self.n_factorizations = 0
+        self.n_solves = 0
+        self.n_factorizations += 1
+        c = 1.0 + scheme.alpha
+        self.a_inv_diag = 1.0 / (1.0 + c * (scheme.gamma * dt * self.c_diag + scheme.beta * dt * dt * self.k_diag))
+
+    def kernel_arrays(self) -> BasisArrays:
+        """What the compiled block loop needs of this basis."""
+        return BasisArrays(
+            MODAL, self.n, _EMPTY_2, _EMPTY_I, _EMPTY_I, _EMPTY_1, _EMPTY_I, _EMPTY_I, _EMPTY_1, 0.0, 0.0, _EMPTY_2,
+            _EMPTY_I, np.zeros((0, self.n)), self.c_diag, self.k_diag, self.a_inv_diag,
+        )
+
+    def sparse_rows(self, rows: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """Modal rows (m,) as (mode index, value) pairs."""
+        vals = np.array(rows, dtype=float).reshape(len(rows), self.n)
+        idx = np.tile(np.arange(self.n, dtype=np.int64), (len(rows), 1))
+        return idx, vals
+
+    def energy(self, d: np.ndarray, v: np.ndarray) -> float:
+        return float(0.5 * v @ v + 0.5 * d @ (self.k_diag * d))
+
+
 def make_basis(
-    bridge: BridgeModel,
+    bridge: BridgeModel | ModalBridge,
     dt: float,
     scheme: Scheme,
     basis: str = "direct",
     n_modes: int | None = None,
     cutoff_hz: float | None = None,
     modal_damping: float | None = None,
-) -> DirectBasis | ModalBasis:
-    """The basis named ``basis`` ("direct" or "modal")."""
+) -> DirectBasis | ModalBasis | DeckModalBasis:
+    """The basis named ``basis`` ("direct" or "modal"). A deck given by its modes is solved on them
+    (:class:`DeckModalBasis`): ``n_modes``/``cutoff_hz``, when given, must describe the modes it keeps (select
+    them on the deck: :meth:`cosim.core.modal_deck.ModalDeck.select`)."""
     if not dt > 0:
         raise ConfigError(f"`dt` must be > 0 s (got {dt})")
+    if isinstance(bridge, ModalBridge):
+        if basis != "modal":
+            raise ConfigError(f"a deck given by its modes is solved on its modes: `basis` must be 'modal' "
+                              f"(got {basis!r})")
+        if n_modes is not None and n_modes != bridge.n_modes:
+            raise ConfigError(f"`modes` = {n_modes}, but the deck keeps {bridge.n_modes}: select the modes on the "
+                              "deck (ModalDeck.select) before building its ModalBridge")
+        if cutoff_hz is not None and bridge.n_modes and float(bridge.f_hz[-1]) > cutoff_hz * (1 + 1e-12):
+            raise ConfigError(f"`cutoff_hz` = {cutoff_hz} Hz, but the deck keeps a mode at "
+                              f"{float(bridge.f_hz[-1]):.6g} Hz: select the modes on the deck first")
+        if modal_damping is not None:
+            raise ConfigError("a deck given by its modes takes its damping from its ModalBridge (ModalRatios)")
+        return DeckModalBasis(bridge, dt, scheme)
     if basis == "direct":
         return DirectBasis(bridge, dt, scheme)
     if basis == "modal":

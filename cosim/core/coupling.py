@@ -38,9 +38,10 @@ import numpy.typing as npt
 from cosim.errors import ConfigError, ModelError
 
 from . import kernels
-from .bases import DirectBasis, ModalBasis
+from .bases import DeckModalBasis, DirectBasis, ModalBasis
 from .bridge import BridgeModel
 from .element import DECK_POINT_DOFS, NODE_DOFS
+from .modal_bridge import ModalBridge
 from .roughness import RoadProfile, smooth_road
 from .schemes import Scheme
 from .sensors import TIME_DERIVATIVE, Sensor, check_sensor_on, sensor_row
@@ -168,8 +169,8 @@ class CoupledSystem:
 
     def __init__(
         self,
-        bridge: BridgeModel,
-        basis: DirectBasis | ModalBasis,
+        bridge: BridgeModel | ModalBridge,
+        basis: DirectBasis | ModalBasis | DeckModalBasis,
         scheme: Scheme,
         dt: float,
         road: RoadProfile | None = None,
@@ -186,7 +187,10 @@ class CoupledSystem:
             raise ConfigError(f"the basis was built for dt = {basis.dt} s and scheme {basis.scheme.name}; "
                               f"build it for dt = {dt} s and scheme {scheme.name} (make_basis)")
         for sensor in sensors:
-            check_sensor_on(bridge, sensor)
+            if isinstance(bridge, ModalBridge):
+                bridge.sensor_row(sensor)  # raises, naming the sensor, when the modes cannot give it
+            else:
+                check_sensor_on(bridge, sensor)
         self.bridge, self.basis, self.scheme, self.dt = bridge, basis, scheme, float(dt)
         self.road = road if road is not None else smooth_road()
         self.gravity = float(gravity)
@@ -195,13 +199,17 @@ class CoupledSystem:
         self._state = kernels.BridgeState(np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n))
         self.n_steps = 0
         self._counters = np.zeros(4, dtype=np.int64)  # lift-off events, lift-off steps, solves, diverged
-        c_w, c_t, _ = bridge.deck_coefficients
-        y_min, y_max = bridge.section.deck_y
-        tol = _Y_TOL * max(y_max - y_min, 1.0)
-        self._y_range = (float(y_min - tol), float(y_max + tol))  # the deck's surface, round-off of lanes allowed
-        self._deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
-                                        float(bridge.section.y_s), float(bridge.length),
-                                        np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS, *self._y_range)
+        if isinstance(bridge, ModalBridge):  # the deck seam: the mode surface says where it is
+            self._y_range = (-math.inf, math.inf)
+            self._deck = bridge.kernel_deck()
+        else:
+            c_w, c_t, _ = bridge.deck_coefficients
+            y_min, y_max = bridge.section.deck_y
+            tol = _Y_TOL * max(y_max - y_min, 1.0)
+            self._y_range = (float(y_min - tol), float(y_max + tol))  # the surface, round-off of lanes allowed
+            self._deck = kernels.DeckArrays(bridge.nodes_x, np.ascontiguousarray(c_w), np.ascontiguousarray(c_t),
+                                            float(bridge.section.y_s), float(bridge.length),
+                                            np.array(DECK_POINT_DOFS, dtype=np.int64), NODE_DOFS, *self._y_range)
         self._scheme = kernels.StepScheme(self.dt, scheme.beta, scheme.gamma, scheme.alpha)
         self._off: dict[str, bool] = {}  # contact points beside the surface at the end of the last block
         self.offdeck_events = 0  # times a wheel over the deck's length went beside its surface
@@ -217,8 +225,14 @@ class CoupledSystem:
         self._vstate = np.zeros((STATE_ROWS, 0))
         self._lifted = np.zeros(0, dtype=bool)
         self.sensors = tuple(sensors)
-        rows = [sensor_row(bridge, s) for s in self.sensors]
-        idx, vals = basis.sparse_rows(rows)
+        rows = []
+        if isinstance(bridge, ModalBridge) and isinstance(basis, DeckModalBasis):
+            idx, vals = basis.sparse_rows([bridge.sensor_row(s) for s in self.sensors])
+        elif isinstance(bridge, BridgeModel) and not isinstance(basis, DeckModalBasis):
+            rows = [sensor_row(bridge, s) for s in self.sensors]
+            idx, vals = basis.sparse_rows(rows)
+        else:
+            raise ConfigError("a deck given by its modes runs on its own modes and a beam on its basis (make_basis)")
         order = np.array([TIME_DERIVATIVE[s.quantity] for s in self.sensors], dtype=np.int64)
         every = np.array([s.every for s in self.sensors], dtype=np.int64)
         self._step0 = np.zeros(1, dtype=np.int64)  # shared by both engines' rows, set before each block
@@ -315,9 +329,12 @@ class CoupledSystem:
         return (y >= self._y_range[0]) & (y <= self._y_range[1])
 
     def _deck_w(self, x: float, y: float) -> float:
+        if isinstance(self.bridge, ModalBridge):
+            return float(self.bridge.deck_w_row(x, y) @ self.d)
         if not kernels.on_deck(x, self.bridge.length) or not bool(self.on_surface(np.array([y]))[0]):
             return 0.0
         row = self.bridge.deck_point_row(x, y)
+        assert not isinstance(self.basis, DeckModalBasis)
         return float(self.basis.reduce_rows(row.dofs[None, :], row.values[:1])[0] @ self.d)
 
     def _sync(self, block: TrafficBlock) -> None:
@@ -470,11 +487,18 @@ class CoupledSystem:
         """The block's steps at which a wheel was over the deck's length but beside its surface (it loaded
         nothing then), counted: an event each time a wheel goes there, and every such wheel-step."""
         K, q = block.x.shape
-        beside = ~self.on_surface(block.y)
+        if isinstance(self.bridge, ModalBridge):  # the surface's edge may depend on x (skewed, curved decks)
+            over = kernels.on_deck(block.x, self.bridge.length)
+            covered = self.bridge.covers(block.x, np.broadcast_to(block.y, block.x.shape))
+            beside = (over & ~covered).any(axis=0)
+        else:
+            beside = ~self.on_surface(block.y)
         off = np.zeros((K, q), dtype=bool)
         if beside.any():
             cols = np.flatnonzero(beside)
             off[:, cols] = kernels.on_deck(block.x[:, cols], self.bridge.length)
+            if isinstance(self.bridge, ModalBridge):
+                off[:, cols] &= ~self.bridge.covers(block.x[:, cols], np.broadcast_to(block.y[cols], (K, len(cols))))
             self.offdeck_steps += int(off.sum())
             before = np.array([self._off.get(block.ids[j], False) for j in cols])
             went = np.diff(np.vstack([before[None, :], off[:, cols]]).astype(np.int8), axis=0) > 0

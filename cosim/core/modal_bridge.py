@@ -179,6 +179,17 @@ class ModalBridge:
     def source(self) -> str:
         return self.deck.source
 
+    def keep(self, n_modes: int | None = None, cutoff_hz: float | None = None) -> ModalBridge:
+        """This bridge with its first ``n_modes`` modes and/or those at or below ``cutoff_hz`` (``[solver] modes``
+        and ``cutoff_hz``); itself when it keeps them all."""
+        deck = self.deck.select(n_modes, cutoff_hz)
+        return self if deck is self.deck else ModalBridge(deck, self.damping, self.placement)
+
+    def path_on_deck(self, y: float) -> bool:
+        """Whether a straight wheel path at lateral offset ``y`` (m) crosses the deck's surface somewhere."""
+        x = np.linspace(0.0, self.length, 201)
+        return bool(self.covers(x, np.full_like(x, float(y))).any())
+
     def covers(self, x: npt.ArrayLike, y: npt.ArrayLike) -> npt.NDArray[np.bool_]:
         """Whether each point (x, y) lies on the deck's surface and its length (0 <= x <= length)."""
         xs = np.atleast_1d(np.asarray(x, dtype=float))

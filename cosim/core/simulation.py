@@ -17,7 +17,7 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, wait
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Protocol
 
@@ -32,6 +32,7 @@ from .checks import finite, one_of
 from .coupling import BlockReport, CoupledSystem
 from .fields import VEHICLE_NUMBERS
 from .jit import compiled
+from .modal_bridge import ModalBridge
 from .quasistatic import QuasiStaticSystem
 from .roughness import RoadProfile
 from .schemes import Scheme
@@ -330,7 +331,7 @@ def _quiet_steps(quiet: Callable[[float], float], done: int, n_steps: int, dt: f
     return max(last - done, 0)
 
 
-def check_traffic_fits(bridge: BridgeModel, traffic: TrafficSource) -> None:
+def check_traffic_fits(bridge: BridgeModel | ModalBridge, traffic: TrafficSource) -> None:
     """Raise :class:`ConfigError` when a traffic source was made for a bridge of another length.
 
     Scripted vehicles and replayed frames know the deck length they move on
@@ -345,13 +346,22 @@ def check_traffic_fits(bridge: BridgeModel, traffic: TrafficSource) -> None:
                           f"{bridge.length:g} m: build the traffic with length = {bridge.length:g}")
 
 
-def check_paths_on_deck(bridge: BridgeModel, traffic: TrafficSource) -> None:
+def check_paths_on_deck(bridge: BridgeModel | ModalBridge, traffic: TrafficSource) -> None:
     """Raise :class:`ConfigError` for a scripted vehicle whose wheel path lies beside the deck's surface.
 
     A scripted vehicle keeps its lateral offset for the whole run: off the deck it would never load it, which
     is a mistake in the script, not traffic. (A traffic simulation's wheel that leaves the surface is an event
     of the run instead: :attr:`cosim.core.coupling.BlockReport.off_surface`.)
     """
+    if isinstance(bridge, ModalBridge):
+        for vehicle in getattr(traffic, "vehicles", ()):
+            y = getattr(vehicle, "y", None)
+            if isinstance(y, (int, float)) and not bridge.path_on_deck(y):
+                lo, hi = bridge.deck_y
+                raise ConfigError(f"vehicle {vehicle.id}: its wheel path y = {y:g} m never crosses the deck's "
+                                  f"surface ({bridge.source or 'its modes'}: {lo:g} <= y <= {hi:g} m at its widest); "
+                                  "put it on a lane of this bridge")
+        return
     y_min, y_max = bridge.section.deck_y
     tol = 1e-9 * max(y_max - y_min, 1.0)
     for vehicle in getattr(traffic, "vehicles", ()):
@@ -361,7 +371,7 @@ def check_paths_on_deck(bridge: BridgeModel, traffic: TrafficSource) -> None:
                               f"({y_min:g} <= y <= {y_max:g} m); put it on a lane of this bridge")
 
 
-def check_road_covers(bridge: BridgeModel, road: RoadProfile) -> None:
+def check_road_covers(bridge: BridgeModel | ModalBridge, road: RoadProfile) -> None:
     """Raise :class:`ConfigError` unless the road profile covers the deck, 0 <= x <= L."""
     x_end = road.x0 + road.dx * (road.r.shape[1] - 1)
     tol = 1e-6 * max(bridge.length, 1.0)
@@ -371,7 +381,7 @@ def check_road_covers(bridge: BridgeModel, road: RoadProfile) -> None:
 
 
 def simulate(
-    bridge: BridgeModel,
+    bridge: BridgeModel | ModalBridge,
     traffic: TrafficSource,
     duration: float,
     solver: SolverSettings = SolverSettings(),
@@ -388,7 +398,9 @@ def simulate(
     """Simulate ``duration`` seconds of traffic on the bridge.
 
     Args:
-        bridge: the structural model (its Rayleigh damping is used).
+        bridge: the structural model: a beam (its Rayleigh damping is used), or a deck given by its modes
+            (:class:`cosim.core.modal_bridge.ModalBridge`: solved on its modes, whatever ``solver.basis``
+            says; ``solver.modes``/``cutoff_hz`` keep the first of them).
         traffic: where the vehicles are at each time (scripted or SUMO).
         duration: simulated time, s.
         solver: time step, scheme and basis.
@@ -427,7 +439,14 @@ def simulate(
         check_road_covers(bridge, road)
     scheme = solver.make_scheme()
     system: CoupledSystem | QuasiStaticSystem
+    if isinstance(bridge, ModalBridge):
+        if solver.method == "quasi-static":
+            raise ConfigError('[solver] method = "quasi-static" needs the beam model\'s influence lines; a deck given '
+                              'by its modes runs with method = "dynamic"')
+        bridge = bridge.keep(solver.modes, solver.cutoff_hz)
+        solver = replace(solver, basis="modal", modes=None, cutoff_hz=None)
     if solver.method == "quasi-static":
+        assert isinstance(bridge, BridgeModel)
         system = QuasiStaticSystem(bridge, tuple(sensors), solver.gravity)
         info = {"basis": "quasi-static (influence lines)", "n_reduced": len(sensors), "scheme": "none",
                 "dt": solver.dt}

@@ -129,3 +129,58 @@ def test_a_scenario_brings_its_modal_basis_and_its_moment_sensors():
     cut = from_beam(parse_scenario(SCENARIO.format(truncation="cutoff_hz = 20.0"), "cut.toml"))
     basis = ModalBasis(bridge, 0.01, Scheme.newmark(), cutoff_hz=20.0)
     assert cut.n_modes == basis.n and np.allclose(cut.omega, basis.omega, rtol=1e-14, atol=0)
+
+
+# ------------------------------------------------------------------------------------------ whole runs
+#: The deck's rows equal the beam's to round-off (above), so whole runs do too; measured: 3e-15 of the peak.
+RUN_EXACT = 1e-9
+
+
+def _fleet():
+    """Every kind of vehicle on both directions, off-centre (bending and twist), one of them unilateral on a
+    rough road (it leaves the deck and lands again)."""
+    from cosim.core.traffic import ScriptedVehicle
+    from cosim.core.vehicles import Axle, HalfCar, MovingForce, QuarterCar, TyreQuarterCar
+    half = HalfCar(m_b=16000.0, i_b=6e4, cg=2.2, axles=(Axle(0.0, 700.0, 6e5, 3e4, 2.5e6, 2e3),
+                                                       Axle(4.0, 1100.0, 9e5, 5e4, 4e6, 3e3)))
+    return (
+        ScriptedVehicle("qc", QuarterCar(m_v=12000.0, m_w=800.0, k_v=5e5, c_v=1e4), 2.0, 18.0),
+        ScriptedVehicle("tyre", TyreQuarterCar(m_v=9000.0, m_w=900.0, k_v=4e5, c_v=8e3, k_t=3e6, c_t=2e3),
+                        -1.0, 25.0, entry_time=0.3),
+        ScriptedVehicle("bouncer", TyreQuarterCar(m_v=400.0, m_w=60.0, k_v=3e4, c_v=1e3, k_t=4e5,
+                                                  unilateral=True), -3.0, 30.0),
+        ScriptedVehicle("half", half, 3.5, 15.0, entry_time=0.5, direction=-1),
+        ScriptedVehicle("force", MovingForce(mass=20000.0), 2.0, 22.0, entry_time=1.0, direction=-1),
+    )
+
+
+@pytest.mark.parametrize("name", ["timoshenko-vlasov", "euler-bernoulli-benscoter"])
+def test_the_beams_modes_imported_reproduce_the_beams_modal_run(name):
+    """A deck given by the beam's own modes (from_beam) runs the same vehicles to the same numbers as the beam
+    on its modal basis (issue 26, item 5): every sensor, contact force and body motion to 1e-9 of the peak."""
+    from cosim.core.modal_bridge import ModalBridge
+    from cosim.core.roughness import iso8608_profile
+    from cosim.core.simulation import SolverSettings, simulate
+    from cosim.core.traffic import ScriptedTraffic
+
+    bridge = two_span_bridge(THEORIES[name])
+    n_modes = 20
+    sensors = [Sensor("mid-1", 9.0, 4.5), Sensor("mid-2", 30.0, -5.5, "acceleration"),
+               Sensor("mid-2v", 30.0, 0.0, "velocity")]
+    road = iso8608_profile("E", 7, 0.0, bridge.length, path_y=(-3.0, -1.0, 2.0, 3.5))
+    settings = SolverSettings(dt=0.002, basis="modal", modes=n_modes)
+    traffic = ScriptedTraffic(_fleet(), bridge.length)
+    beam = simulate(bridge, traffic, 3.5, settings, sensors, road=road)
+    deck = ModalBridge(from_beam(bridge, n_modes=n_modes, lateral=3))
+    modal = simulate(deck, ScriptedTraffic(_fleet(), deck.length), 3.5, settings, sensors, road=road)
+    for s in sensors:
+        ref = beam.sensors[s.name]
+        assert np.max(np.abs(modal.sensors[s.name] - ref)) <= RUN_EXACT * np.max(np.abs(ref)), s.name
+    assert modal.vehicle_ids == beam.vehicle_ids
+    for vid in beam.vehicle_ids:
+        for column in ("contact_force", "body_displacement", "body_acceleration"):
+            ref = beam.vehicle(vid)[column]
+            got = modal.vehicle(vid)[column]
+            assert got.shape == ref.shape and np.max(np.abs(got - ref)) <= RUN_EXACT * np.max(np.abs(ref)), (vid,
+                                                                                                            column)
+    assert beam.liftoff_events > 0 and modal.liftoff_events == beam.liftoff_events
