@@ -51,6 +51,7 @@ import numpy.typing as npt
 
 from cosim.core.bridge import BridgeModel
 from cosim.core.fields import VEHICLE_NUMBERS
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.quasistatic import QuasiStaticResult, quasi_static
 from cosim.errors import ConfigError
 from cosim.run.config_base import load_config
@@ -237,7 +238,7 @@ class Results:
     log_path: Path | None = None
     wall_time: float = 0.0
     _vehicles: dict[str, dict[str, npt.NDArray[np.float64]]] | None = field(default=None, repr=False)
-    _bridge: BridgeModel | None = field(default=None, repr=False)
+    _bridge: BridgeModel | ModalBridge | None = field(default=None, repr=False)
     _qs: QuasiStaticResult | None = field(default=None, repr=False)
 
     # ------------------------------------------------------------- channels
@@ -288,8 +289,8 @@ class Results:
 
     # --------------------------------------------------------- quasi-static
     @property
-    def bridge(self) -> BridgeModel:
-        """The scenario's bridge model (built once)."""
+    def bridge(self) -> BridgeModel | ModalBridge:
+        """The scenario's bridge model (built once): a beam, or a deck given by its modes."""
         if self._bridge is None:
             self._bridge = self.scenario.build_bridge()
         return self._bridge
@@ -297,7 +298,11 @@ class Results:
     def quasi_static(self) -> QuasiStaticResult:
         """The quasi-static run of the same traffic (weights, no inertia), at every step; computed once."""
         if self._qs is None:
-            self._qs = quasi_static(self.bridge, self._traffic(), self.duration, self.scenario.solver.dt,
+            bridge = self.bridge
+            if isinstance(bridge, ModalBridge):
+                raise ConfigError(f"{self.scenario.source}: the quasi-static response (static_peak, daf) needs the "
+                                  "beam model's influence lines; a deck given by its modes has none")
+            self._qs = quasi_static(bridge, self._traffic(), self.duration, self.scenario.solver.dt,
                                     self.scenario.sensors_core(), self.scenario.solver.gravity,
                                     output_every=self.scenario.output_every)
         return self._qs
@@ -327,8 +332,11 @@ class Results:
         return _daf(self.peak(name), self.static_peak(name))
 
     def frequencies(self, count: int = 5) -> npt.NDArray[np.float64]:
-        """The bridge's lowest natural frequencies, Hz."""
-        return self.bridge.modes(count).f_hz
+        """The bridge's lowest natural frequencies, Hz (a deck given by its modes: the first of its file's)."""
+        bridge = self.bridge
+        if isinstance(bridge, ModalBridge):
+            return np.array(bridge.f_hz[:count])
+        return bridge.modes(count).f_hz
 
 
 #: A vehicle's samples in :class:`Results`: the time and every numeric field of the log's vehicle items.
@@ -354,7 +362,7 @@ def _vehicles_from_log(path: Path) -> dict[str, dict[str, npt.NDArray[np.float64
     return out
 
 
-def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Results:
+def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel | ModalBridge) -> Results:
     vehicles = {}
     for vid in result.vehicle_ids:
         v = result.vehicle(vid)
@@ -369,7 +377,7 @@ def _from_simulation(sc: Scenario, result: Any, bridge_model: BridgeModel) -> Re
     )
 
 
-def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel,
+def _from_log(sc: Scenario, outcome: Any, bridge_model: BridgeModel | ModalBridge,
               vehicles: dict[str, dict[str, npt.NDArray[np.float64]]] | None = None) -> Results:
     """The results of a logged run, read from its log (the vehicles' samples too if not given: when first asked)."""
     from cosim.log.reader import sensor_series
@@ -422,7 +430,8 @@ def run(base: Scenario | str | os.PathLike[str] | Mapping[str, Any] | None = Non
         outcome = run_logged(sc, folder / "run.mcap", force=True, bridge=model)
         # What the log holds is read before it goes: the vehicles now, the logged traffic by quasi_static().
         res = _from_log(sc, outcome, model, vehicles=_vehicles_from_log(Path(outcome.log_path)))
-        res.quasi_static()
+        if isinstance(model, BridgeModel):  # a deck given by its modes has no influence lines to run
+            res.quasi_static()
         res.log_path = None
         return res
     finally:
@@ -578,9 +587,9 @@ if pytest is not None:
     @pytest.fixture(scope="session")
     def cosim_bridge() -> Any:
         """Factory: ``cosim_bridge(scenario_or_path) -> BridgeModel``, each distinct bridge built once per session."""
-        cache: dict[str, BridgeModel] = {}
+        cache: dict[str, BridgeModel | ModalBridge] = {}
 
-        def build(base: Any = None, **overrides: Any) -> BridgeModel:
+        def build(base: Any = None, **overrides: Any) -> BridgeModel | ModalBridge:
             sc = scenario(base, **overrides)
             key = repr(sc.bridge.model_dump())
             if key not in cache:

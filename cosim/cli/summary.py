@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.traffic import vehicle_of
 from cosim.run.api import RunStart
 from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome
@@ -203,7 +204,10 @@ def _solver_line(scenario: Scenario, duration: float) -> str:
     solver = scenario.solver
     scheme = solver.scheme if solver.scheme != "hht" else f"hht (alpha = {fmt_g(solver.hht_alpha or 0.0)})"
     basis = solver.basis
-    if solver.basis == "modal":
+    if scenario.bridge.is_modal:
+        kept = scenario.bridge.deck.select(solver.modes, solver.cutoff_hz).n_modes
+        basis = f"modal (the deck's {kept} of its file's {scenario.bridge.deck.n_modes} modes)"
+    elif solver.basis == "modal":
         if solver.modes is not None:
             basis += f" ({solver.modes} modes)"
         else:
@@ -331,10 +335,18 @@ def _log_done_line(outcome: RunOutcome) -> str:
 def header_lines(start: RunStart) -> list[str]:
     """What a logged run prints before its time stepping: bridge, damping, traffic, road, solver, log."""
     scenario, bridge = start.scenario, start.bridge
-    spans = " + ".join(f"{span:g}" for span in bridge.spans)
+    if isinstance(bridge, ModalBridge):
+        lo, hi = bridge.deck_y
+        structure = [f"Bridge: a deck given by its modes, {bridge.source}: {bridge.n_modes} modes, "
+                     f"{fmt_g(float(bridge.f_hz[0]), 4)} to {fmt_g(float(bridge.f_hz[-1]), 4)} Hz; "
+                     f"{bridge.deck.points.shape[0]} deck points, 0 <= x <= {bridge.length:g} m, "
+                     f"{lo:g} <= y <= {hi:g} m ({bridge.placement})",
+                     f"Damping: {bridge.damping_note}"]
+    else:
+        spans = " + ".join(f"{span:g}" for span in bridge.spans)
+        structure = [f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements", *damping_lines(bridge)]
     return [
-        f"Bridge: {spans} m, {len(bridge.nodes_x) - 1} elements",
-        *damping_lines(bridge),
+        *structure,
         *(["Traffic: the replayed log's SUMO frames"] if start.replayed_frames
           else _vehicle_lines(scenario, start.plan)),
         _road_line(scenario),

@@ -94,7 +94,7 @@ def damaged_bridge(scenario: Scenario, case: DamageConfig, e_factor: float) -> A
     with scenario.named("bridge"):
         return build_bridge(spans=config.spans, elements_per_span=config.elements_per_span, material=scaled,
                             section=section, supports=config.supports,
-                            damping=config.damping.to_damping() if config.damping is not None else None,
+                            damping=config.damping.beam_damping() if config.damping is not None else None,
                             theory=config.theory(), stiffness_factors=factors, support_springs=springs)
 
 

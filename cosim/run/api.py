@@ -25,6 +25,7 @@ from typing import Any
 
 from cosim import plots
 from cosim.core.bridge import BridgeModel, ModalResult, PointLoad
+from cosim.core.modal_bridge import ModalBridge
 from cosim.errors import CosimError
 
 from .export import export_csv
@@ -51,14 +52,14 @@ class RunStart:
     """A logged run about to start its time stepping (``cosim run`` and ``cosim replay`` print it first).
 
     Attributes:
-        scenario: what runs; bridge: its model, built.
+        scenario: what runs; bridge: its model, built (a beam, or a deck given by its modes).
         log_path: the log it writes (checked: it may be written).
         duration: the simulated time, s.
         plan: with SUMO traffic, its network and vehicle types as read (None for scripted vehicles and replays).
     """
 
     scenario: Scenario
-    bridge: BridgeModel
+    bridge: BridgeModel | ModalBridge
     log_path: Path
     duration: float
     plan: SumoPlan | None = None
@@ -201,7 +202,7 @@ def _static_run(scenario: Scenario, out: str | os.PathLike[str] | None, csv: str
         check_writable(out, "summary", force=force)
     if checked is not None:
         checked(scenario)
-    bridge = scenario.build_bridge()
+    bridge = scenario.build_beam()
     modal = bridge.modes(count=STATIC_MODES)
     cases = tuple(static_cases(scenario, bridge))
     if out is None:
@@ -250,7 +251,7 @@ def bridge_modes(scenario: str | os.PathLike[str] | Scenario, count: int = 10, *
     if plot:
         check_not_input(plot, "plot", scenario_files(scenario))
         check_writable(plot, "plot", plots.figure_formats(), force=force)
-    bridge = scenario.build_bridge()
+    bridge = scenario.build_beam()
     modal = bridge.modes(count=count)
     plotted = plot_modes(bridge, modal, plot, count) if plot else 0
     return BridgeModes(scenario, bridge, modal, plotted)
@@ -281,5 +282,5 @@ def static_loads(scenario: str | os.PathLike[str] | Scenario,
     if not isinstance(scenario, Scenario):
         scenario = load_scenario(scenario)
     points = [PointLoad(x=x, y=y, Fz=fz) for x, y, fz in loads]
-    bridge = scenario.build_bridge()
+    bridge = scenario.build_beam()
     return StaticLoads(scenario, bridge, static_response(scenario, bridge, points))

@@ -12,7 +12,7 @@ import math
 import re
 from typing import Annotated, Any, Union
 
-from pydantic import Field, PlainValidator, Strict, field_validator, model_validator
+from pydantic import Field, PlainValidator, PrivateAttr, Strict, field_validator, model_validator
 
 from cosim.core.bridge import (
     DOF_NAMES,
@@ -22,6 +22,8 @@ from cosim.core.bridge import (
 )
 from cosim.core.bridge import MODE_KINDS as _BRIDGE_MODE_KINDS
 from cosim.core.element import BENDING_THEORIES, TORSION_THEORIES, BeamTheory
+from cosim.core.modal_bridge import ModalRatios
+from cosim.core.modal_deck import ModalDeck
 from cosim.core.section import (
     Material,
     Plate,
@@ -55,6 +57,11 @@ __all__ = [
     "PlateConfig",
     "SectionConfig",
 ]
+
+#: The frames a modes file's points may be given in (docs/modal-decks.md).
+MODE_FRAMES: tuple[str, ...] = ("bridge", "network")
+#: Keys of a beam bridge, not used with ``modes``.
+BEAM_KEYS: tuple[str, ...] = ("spans", "elements_per_span", "material", "section", "supports", "torsion", "bending")
 
 #: Mode kinds a damping mode reference may name ("vertical-1", "torsion-2", ...).
 MODE_KINDS: tuple[str, ...] = tuple(_BRIDGE_MODE_KINDS)
@@ -141,6 +148,7 @@ def _mode_ref(value: Any) -> int | str:
 
 
 ModeRef = Annotated[Union[int, str], PlainValidator(_mode_ref)]
+Ratio = Annotated[float, Strict(), Field(ge=0.0, lt=1.0)]
 """A mode: 1-based number in frequency order, or "<kind>-<n>" (n-th mode of that kind)."""
 
 
@@ -299,8 +307,10 @@ class SectionConfig(ConfigModel):
 
 
 class DampingConfig(ConfigModel):
-    """``[bridge.damping]``: Rayleigh damping from two target ratios at two modes, or explicit alpha/beta."""
+    """``[bridge.damping]``: Rayleigh damping from two target ratios at two modes, or explicit alpha/beta; on a
+    deck given by its modes also ``ratio``: one damping ratio for every mode, or one per mode."""
 
+    ratio: Union[Ratio, tuple[Ratio, ...]] | None = None
     ratios: tuple[Annotated[float, Strict(), Field(ge=0.0, lt=1.0)], ...] | None = None
     modes: tuple[ModeRef, ...] | None = None
     alpha: NonNegative | None = None
@@ -324,6 +334,13 @@ class DampingConfig(ConfigModel):
     def _one_form(self) -> DampingConfig:
         rayleigh = self.ratios is not None or self.modes is not None
         explicit = self.alpha is not None or self.beta is not None
+        if self.ratio is not None:
+            if rayleigh or explicit:
+                raise fail("give one of ratio (modal damping, a deck given by its modes), ratios + modes or "
+                           "alpha + beta, not more", "ratio")
+            if isinstance(self.ratio, tuple) and not self.ratio:
+                raise fail("expected a damping ratio or one per mode, got []", "ratio")
+            return self
         if rayleigh and explicit:
             raise fail("give either ratios + modes or alpha + beta, not both")
         if rayleigh and (self.ratios is None or self.modes is None):
@@ -336,8 +353,17 @@ class DampingConfig(ConfigModel):
             raise fail("give ratios + modes or alpha + beta (or remove [bridge.damping] for no damping)")
         return self
 
-    def to_damping(self) -> RayleighDamping | ExplicitDamping:
-        """The :mod:`cosim.core.bridge` damping specification."""
+    def beam_damping(self) -> RayleighDamping | ExplicitDamping:
+        """The beam's Rayleigh damping (``ratio`` is refused for beams by :class:`BridgeConfig`)."""
+        damping = self.to_damping()
+        assert not isinstance(damping, ModalRatios)
+        return damping
+
+    def to_damping(self) -> RayleighDamping | ExplicitDamping | ModalRatios:
+        """The :mod:`cosim.core.bridge` damping specification (``ratio``: the modal deck's
+        :class:`cosim.core.modal_bridge.ModalRatios`)."""
+        if self.ratio is not None:
+            return ModalRatios(self.ratio)
         if self.ratios is not None:
             assert self.modes is not None
             (z1, z2), (m1, m2) = self.ratios, self.modes  # two of each, checked by the validators
@@ -347,27 +373,89 @@ class DampingConfig(ConfigModel):
 
 
 class BridgeConfig(ConfigModel):
-    """``[bridge]``: a straight continuous beam of one or more spans."""
+    """``[bridge]``: a straight continuous beam of one or more spans, or a deck given by its modes (``modes``:
+    a modes file, docs/modal-decks.md; ``frame``: the frame of its points)."""
 
     name: Annotated[str, Strict(), Field(min_length=1)] | None = None
-    spans: tuple[Positive, ...]
+    spans: tuple[Positive, ...] = ()
     elements_per_span: Annotated[Union[int, tuple[int, ...]], PlainValidator(_elements_per_span)] = 20
-    material: MaterialConfig
-    section: SectionConfig
-    supports: Annotated[tuple[Union[str, tuple[str, ...]], ...], PlainValidator(_supports)]
+    material: MaterialConfig | None = None
+    section: SectionConfig | None = None
+    supports: Annotated[tuple[Union[str, tuple[str, ...]], ...], PlainValidator(_supports)] = ()
     damping: DampingConfig | None = None
     torsion: Annotated[str, choice(TORSION_THEORIES, "torsion theory")] = "vlasov"
     bending: Annotated[str, choice(BENDING_THEORIES, "bending theory")] = "timoshenko"
+    modes: Annotated[str, Strict(), Field(min_length=1)] | None = None
+    frame: Annotated[str, choice(MODE_FRAMES, "frame")] = "bridge"
 
-    @field_validator("spans")
-    @classmethod
-    def _some_spans(cls, value: tuple[float, ...]) -> tuple[float, ...]:
-        if not value:
-            raise fail("expected one or more span lengths, got []")
-        return value
+    #: The modes file's deck once the scenario has read it (:meth:`cosim.run.scenario.Scenario.modal_deck`).
+    _deck: ModalDeck | None = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _beam_or_modes(self) -> BridgeConfig:
+        if self.modes is not None:
+            beam = [k for k in BEAM_KEYS if k in self.model_fields_set]
+            if beam:
+                raise fail("not used with modes: a deck given by its modes has no spans, section, material, "
+                           "supports or beam theory (they are the FE model's); remove it, or remove modes",
+                           beam[0])
+            return self
+        if "frame" in self.model_fields_set:
+            raise fail("only used with modes (the frame of a modes file's points)", "frame")
+        if self.damping is not None and self.damping.ratio is not None:
+            raise fail("a beam's damping is Rayleigh: give ratios + modes or alpha + beta (ratio is the modal "
+                       "damping of a deck given by its modes)", "damping", "ratio")
+        for key in ("spans", "material", "section", "supports"):
+            if key not in self.model_fields_set:
+                raise fail("required key is missing (a beam bridge: spans, material, section and supports; or a "
+                           "deck given by its modes: modes = \"FILE\")", key)
+        if not self.spans:
+            raise fail("expected one or more span lengths, got []", "spans")
+        return self
+
+    @property
+    def is_modal(self) -> bool:
+        """Whether the bridge is a deck given by its modes (``modes``)."""
+        return self.modes is not None
+
+    def keep_deck(self, deck: ModalDeck) -> None:
+        """Keep the modes file's deck, read (and checked) by the scenario, which knows the file's folder."""
+        self._deck = deck
+
+    @property
+    def deck(self) -> ModalDeck:
+        """The modes file's deck (after validation of a scenario with ``modes``)."""
+        if self._deck is None:
+            raise ValueError("bridge.modes: the modes file has not been read (validate the scenario)")
+        return self._deck
+
+    @property
+    def deck_y(self) -> tuple[float, float]:
+        """The deck's lateral extent (y_min, y_max), m: the section's, or the modes file's points'."""
+        if self.modes is not None:
+            y = self.deck.points[:, 1]
+            return float(y.min()), float(y.max())
+        assert self.section is not None
+        return self.section.deck_y
+
+    @property
+    def beam_section(self) -> SectionConfig:
+        """``[bridge.section]`` of a beam bridge."""
+        if self.section is None:
+            raise ValueError("bridge.section: a deck given by its modes has no section")
+        return self.section
+
+    @property
+    def beam_material(self) -> MaterialConfig:
+        """``[bridge.material]`` of a beam bridge."""
+        if self.material is None:
+            raise ValueError("bridge.material: a deck given by its modes has no material")
+        return self.material
 
     @model_validator(mode="after")
     def _counts(self) -> BridgeConfig:
+        if self.modes is not None:
+            return self
         problems: list[tuple[tuple[str, ...], str]] = []
         n = len(self.spans)
         if isinstance(self.elements_per_span, tuple) and len(self.elements_per_span) != n:
@@ -379,7 +467,7 @@ class BridgeConfig(ConfigModel):
                 (("supports",), f"expected {n + 1} entries (one per support line: len(spans) + 1), "
                                 f"got {len(self.supports)}")
             )
-        constants = self.section.constants
+        constants = self.beam_section.constants
         if (self.torsion == "benscoter" and constants is not None and constants.I_w > 0
                 and constants.I_ws is None):
             problems.append(
@@ -393,7 +481,9 @@ class BridgeConfig(ConfigModel):
 
     @property
     def length(self) -> float:
-        """Total length, m."""
+        """Total length, m: the spans', or the modes file's deck's extent along x."""
+        if self.modes is not None:
+            return float(self.deck.points[:, 0].max())
         return float(sum(self.spans))
 
     def theory(self) -> BeamTheory:

@@ -25,13 +25,20 @@ class InputFile:
 
 
 def input_files(scenario: Scenario) -> list[InputFile]:
-    """The scenario's input files (the road profile, the record file, the SUMO config and the files it names),
+    """The scenario's input files (the modes file, the road profile, the record file, the SUMO config and the
+    files it names),
     with the names they get in a log.
 
     A relative path inside the scenario's folder keeps its name (``data/road.csv``);
     any other path is stored as ``inputs/<file name>``.
     """
     found = []
+    modes = scenario.modes_path
+    if modes is not None and scenario.bridge.modes is not None:
+        item = _own_file("bridge.modes", scenario.bridge.modes, modes)
+        if modes.is_dir():  # a folder of CSV files travels as the one .npz it reads as (the same deck, bit for bit)
+            item = InputFile(item.key, item.written, modes, f"{item.attachment.rstrip('/')}.npz")
+        found.append(item)
     profile = scenario.road_profile_path
     if profile is not None and scenario.road.profile is not None:
         found.append(_own_file("road.profile", scenario.road.profile, profile))

@@ -16,6 +16,7 @@ import json
 import os
 import platform
 import secrets
+import tempfile
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -26,10 +27,12 @@ import numpy as np
 
 from cosim import __version__
 from cosim.analysis.fatigue import FatigueResult
+from cosim.bridges.files import read_modes, write_modes
 from cosim.core.bases import DirectBasis
 from cosim.core.bridge import BridgeModel
 from cosim.core.checks import one_of
 from cosim.core.limits import MAX_STEPS
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.roughness import RoadProfile
 from cosim.core.sensors import Sensor
 from cosim.core.simulation import SimulationResult, SolverSettings, simulate
@@ -51,7 +54,7 @@ from cosim.log.writer import BlockLogger, LogRecorder
 from .engineering import FatigueRecorder, fatigue_payload, stress_curves
 from .inputs import input_files
 from .outputs import check_new_file
-from .payloads import damping_payload, jsonable, modes_payload, section_payload
+from .payloads import damping_payload, jsonable, modal_deck_payload, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
 from .simulate import SOLVER_FAILURES, SumoPlan, build_traffic, likely_cause, plan_sumo, scripted_traffic
@@ -186,11 +189,16 @@ def _contact_ids(traffic: Any) -> list[str] | None:
     return ids
 
 
-def _scene_plan(scenario: Scenario, bridge: BridgeModel, sensors: list, solver: Any, duration: float,
+def _scene_plan(scenario: Scenario, bridge: BridgeModel | ModalBridge, sensors: list, solver: Any, duration: float,
                 traffic: Any, by_default: bool = True) -> ScenePlan | None:
     """The run's 3D scene (``[output].scene``; unset: on for runs of at most an hour unless not
-    ``by_default``), or None."""
+    ``by_default``), or None. A deck given by its modes has no scene yet (its shape is not a beam's)."""
     setting = scenario.output.scene
+    if isinstance(bridge, ModalBridge):
+        if setting not in (None, False):
+            raise ConfigError(f"{scenario.source}: output.scene: the 3D scene draws a beam's deck; a deck given by "
+                              "its modes is not drawn yet: remove scene (its sensors and traffic are logged)")
+        return None
     if setting is None and not by_default:
         return None
     if not scene_wanted(setting, duration):
@@ -214,7 +222,7 @@ def _named_only(result: SimulationResult, names: list[str]) -> SimulationResult:
         sensor_min={n: result.sensor_min[n] for n in names}, sensor_max={n: result.sensor_max[n] for n in names})
 
 
-def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: float, given: bool,
+def _check_size(scenario: Scenario, bridge: BridgeModel | ModalBridge, solver: Any, duration: float, given: bool,
                 modal: Any) -> None:
     """Bounds that the run itself would only hit after its log exists: time steps, the basis."""
     if given:
@@ -229,6 +237,9 @@ def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: 
     else:
         key = f"{scenario.source}: solver.duration (default: the last vehicle leaves the deck + {RING_DOWN:g} s)"
     MAX_STEPS.check(duration / solver.dt, key, f"{duration:g} s at solver.dt = {solver.dt:g} s")
+    if modal is None:  # a deck given by its modes: its modes were checked when the scenario was read
+        return
+    assert isinstance(bridge, BridgeModel)
     if solver.basis == "direct" and len(bridge.free) > DirectBasis.MAX_DIRECT_DOFS:
         raise ConfigError(
             f"{scenario.source}: solver.basis: the direct basis keeps a dense {len(bridge.free)} x "
@@ -291,7 +302,7 @@ class RunPlan:
     scenario: Scenario
     log_path: Path
     force: bool
-    bridge: BridgeModel
+    bridge: BridgeModel | ModalBridge
     road: RoadProfile
     solver: SolverSettings
     sensors: tuple[Sensor, ...]
@@ -340,14 +351,23 @@ def _metadata(scenario: Scenario, plan_scene_: ScenePlan | None, solver: SolverS
     }
 
 
-def _documents(scenario: Scenario, bridge: BridgeModel, modal: Any, inputs: list, attachments: dict[str, bytes],
-               layout: Any, duration: float, every: int, rate_hz: float) -> dict[str, bytes]:
+def _input_bytes(path: Path) -> bytes:
+    """An input file's bytes; a folder of modes CSV files as the .npz it reads as (docs/modal-decks.md)."""
+    if not path.is_dir():
+        return path.read_bytes()
+    with tempfile.TemporaryDirectory(prefix="cosim-modes-") as scratch:
+        return write_modes(Path(scratch) / "modes.npz", read_modes(path)).read_bytes()
+
+
+def _documents(scenario: Scenario, bridge: BridgeModel | ModalBridge, modal: Any, inputs: list,
+               attachments: dict[str, bytes], layout: Any, duration: float, every: int,
+               rate_hz: float) -> dict[str, bytes]:
     """The log's attachments besides the scenario text: its input files (read now: an unreadable one is an
     error before the log exists), the resolved parameters, the section, the modes and the Foxglove layout."""
     files = {}
     for item in inputs:
         try:
-            files[item.attachment] = item.path.read_bytes()
+            files[item.attachment] = _input_bytes(item.path)
         except OSError as exc:
             raise ConfigError(f"{scenario.source}: {item.key or item.attachment}: cannot read {item.path} "
                               f"({exc.strerror})") from None
@@ -356,12 +376,16 @@ def _documents(scenario: Scenario, bridge: BridgeModel, modal: Any, inputs: list
         "derived": {"duration": duration, "output_every": every, "rate_hz": rate_hz,
                     "leave_time": jsonable(scenario.leave_time)},
     }
+    if isinstance(bridge, ModalBridge):
+        structure = {"modes.json": json.dumps(modal_deck_payload(bridge), indent=1).encode()}
+    else:
+        structure = {"section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
+                     "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
+                                              indent=1).encode()}
     return {
         **files, **attachments,
         "resolved.json": json.dumps(jsonable(resolved), indent=1).encode(),
-        "section.json": json.dumps(section_payload(bridge.section), indent=1).encode(),
-        "modes.json": json.dumps({"modes": modes_payload(modal), "damping": damping_payload(bridge)},
-                                 indent=1).encode(),
+        **structure,
         LAYOUT_ATTACHMENT: layout_bytes(layout),
     }
 
@@ -371,7 +395,7 @@ def plan_run(
     log_path: Path,
     *,
     force: bool = False,
-    bridge: BridgeModel | None = None,
+    bridge: BridgeModel | ModalBridge | None = None,
     replay: dict[str, str] | None = None,
     attachments: dict[str, bytes] | None = None,
     started: datetime.datetime | None = None,
@@ -409,7 +433,7 @@ def plan_run(
     every = scenario.output_every
     rate_hz = scenario.output_rate_hz
     names = [s.name for s in sensors]
-    modal = bridge.modes(count=LOGGED_MODES)
+    modal = bridge.modes(count=LOGGED_MODES) if isinstance(bridge, BridgeModel) else None
     _check_size(scenario, bridge, solver, duration, given, modal)
     scene = _scene_plan(scenario, bridge, sensors, solver, duration, traffic, scene_by_default)
     inputs = input_files(scenario)
@@ -428,7 +452,7 @@ def run_logged(
     log_path: Path,
     *,
     force: bool = False,
-    bridge: BridgeModel | None = None,
+    bridge: BridgeModel | ModalBridge | None = None,
     progress: Callable[[float], None] | None = None,
     replay: dict[str, str] | None = None,
     attachments: dict[str, bytes] | None = None,

@@ -11,6 +11,7 @@ from typing import Any
 
 from cosim.core.bridge import BridgeModel, ModalResult
 from cosim.core.element import DOF_INDEX, NODE_DOFS
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.section import SectionProperties
 
 #: What the mode shapes of :func:`modes_payload` hold and in which units.
@@ -63,6 +64,21 @@ def modes_payload(modal: ModalResult, shapes: bool = False) -> list[dict[str, An
         for i, entry in enumerate(entries):
             entry["shape"] = {"w": w_axis[:, i].tolist(), "theta_x": twist[:, i].tolist(), "v": v[:, i].tolist()}
     return entries
+
+
+def modal_deck_payload(bridge: ModalBridge) -> dict[str, Any]:
+    """A deck given by its modes: where its modes came from, each mode's frequency and damping ratio, the deck's
+    extent and how it was placed."""
+    return {
+        "source": bridge.source,
+        "placement": bridge.placement,
+        "length": float(bridge.length),
+        "deck_y": [float(v) for v in bridge.deck_y],
+        "points": int(bridge.deck.points.shape[0]),
+        "modes": [{"n": i + 1, "f_hz": float(f), "zeta": float(z)} for i, (f, z) in enumerate(zip(bridge.f_hz,
+                                                                                                 bridge.zeta))],
+        "damping": {"note": bridge.damping_note},
+    }
 
 
 def damping_payload(bridge: BridgeModel) -> dict[str, Any]:

@@ -44,7 +44,7 @@ else:  # pragma: no cover - Python 3.10
 
 
 #: The scenario keys that name input files; a replay takes each from the log's attachments only.
-FILE_KEYS: tuple[str, ...] = ("road.profile", "traffic.sumo_config", "traffic.records.file")
+FILE_KEYS: tuple[str, ...] = ("bridge.modes", "road.profile", "traffic.sumo_config", "traffic.records.file")
 #: Attachments that are documents about the run, not its input files.
 DERIVED_ATTACHMENTS = frozenset({SCENARIO_ATTACHMENT, "resolved.json", "section.json", "modes.json"})
 _DRIVE = re.compile(r"^[A-Za-z]:")

@@ -52,6 +52,7 @@ from pydantic import (
 )
 
 from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, build_bridge
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.records_traffic import RecordsCheck, RecordTraffic, check_records
 from cosim.core.roughness import (
     RoadProfile,
@@ -194,6 +195,23 @@ class Scenario(ConfigModel):
 
     @model_validator(mode="before")
     @classmethod
+    def _modal_solver(cls, data: Any, info: ValidationInfo) -> Any:
+        """A deck given by its modes is solved on its modes: ``[solver] basis`` is "modal" whether given or
+        not, and it keeps every mode of the file unless ``modes`` or ``cutoff_hz`` says otherwise."""
+        if not (isinstance(data, dict) and isinstance(data.get("bridge"), dict) and "modes" in data["bridge"]):
+            return data
+        solver = data.get("solver", {})
+        if not isinstance(solver, dict):
+            return data
+        if solver.get("basis", "modal") != "modal":
+            raise fail(f"a deck given by its modes is solved on its modes: remove basis or write basis = \"modal\" "
+                       f"(got {show(solver['basis'])})", "solver", "basis")
+        if isinstance(info.context, dict):
+            info.context["all_modes"] = True  # SolverConfig: no default count of modes
+        return {**data, "solver": {**solver, "basis": "modal"}}
+
+    @model_validator(mode="before")
+    @classmethod
     def _default_vehicle_ids(cls, data: Any) -> Any:
         """Vehicles without an ``id`` are "V1", "V2", ... by their position."""
         if isinstance(data, dict) and isinstance(data.get("vehicles"), list):
@@ -205,10 +223,47 @@ class Scenario(ConfigModel):
         return data
 
     @model_validator(mode="after")
+    def _modes_file(self, info: ValidationInfo) -> Scenario:
+        """``[bridge] modes``: the file read (bounded, no pickles) and checked before any other check needs the
+        deck's extent; its damping and the solver's choice of modes fit it."""
+        bridge = self.bridge
+        if bridge.modes is None:
+            return self
+        if bridge.frame == "network" and (self.traffic is None or not self.traffic.sumo):
+            raise fail('frame = "network" places the deck by a SUMO network\'s coordinates: give [traffic] '
+                       'sumo_config, or give the points in the bridge frame (frame = "bridge")', "bridge", "frame")
+        base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
+        path = Path(base) / bridge.modes
+        if not path.exists():
+            raise fail(f"file not found: {path} (a .npz file or a folder of CSV files, docs/modal-decks.md; a "
+                       "relative path is relative to the scenario file's folder)", "bridge", "modes")
+        from cosim.bridges.files import read_modes
+
+        try:
+            deck = read_modes(path, frame=bridge.frame)
+        except ConfigError as exc:
+            raise fail(str(exc), "bridge", "modes") from None
+        if self.solver.method == "quasi-static":
+            raise fail('a deck given by its modes runs with method = "dynamic" (the quasi-static method uses the '
+                       "beam model's influence lines)", "solver", "method")
+        bridge.keep_deck(deck)
+        if bridge.frame == "bridge":
+            try:
+                built = self.build_modal_bridge()
+            except ConfigError as exc:
+                raise fail(str(exc).split(": bridge: ", 1)[-1], "bridge", "modes") from None
+            for i, sensor in enumerate(self.sensors):
+                try:
+                    built.sensor_row(sensor.to_sensor())
+                except ConfigError as exc:
+                    raise fail(str(exc), "sensors", i) from None
+        return self
+
+    @model_validator(mode="after")
     def _sensors_on_deck(self) -> Scenario:
         problems: list[tuple[tuple[str | int, ...], str]] = []
         length = self.bridge.length
-        y_min, y_max = self.bridge.section.deck_y
+        y_min, y_max = self.bridge.deck_y
         tol_x = 1e-9 * length
         tol_y = 1e-9 * max(y_max - y_min, 1.0)
         seen: dict[str, int] = {}
@@ -235,7 +290,7 @@ class Scenario(ConfigModel):
     @model_validator(mode="after")
     def _vehicles_fit(self) -> Scenario:
         problems: list[tuple[tuple[str | int, ...], str]] = []
-        y_min, y_max = self.bridge.section.deck_y
+        y_min, y_max = self.bridge.deck_y
         tol_y = 1e-9 * max(y_max - y_min, 1.0)
         seen: dict[str, int] = {}
         for i, vehicle in enumerate(self.vehicles):
@@ -303,7 +358,7 @@ class Scenario(ConfigModel):
         if not path.is_file():
             raise fail(f"file not found: {path} (a relative path is relative to the scenario file's folder)",
                        "traffic", "records", "file")
-        y_min, y_max = self.bridge.section.deck_y
+        y_min, y_max = self.bridge.deck_y
         tol_y = 1e-9 * max(y_max - y_min, 1.0)
         problems: list[tuple[tuple[str | int, ...], str]] = []
         for i, lane in enumerate(records.lanes):
@@ -434,7 +489,7 @@ class Scenario(ConfigModel):
 
     def material(self) -> Material:
         """The bridge's :class:`cosim.core.section.Material`."""
-        return self.bridge.material.to_material()
+        return self.bridge.beam_material.to_material()
 
     def build_section(self) -> SectionProperties:
         """The bridge's section constants (runs the FE section solver for plates).
@@ -444,10 +499,12 @@ class Scenario(ConfigModel):
                 not touch); the message names the scenario and ``bridge.section``.
         """
         with self.named("bridge.section"):
-            return self.bridge.section.build(nu=self.bridge.material.poisson)
+            return self.bridge.beam_section.build(nu=self.bridge.beam_material.poisson)
 
-    def build_bridge(self) -> BridgeModel:
-        """The finite-element bridge model (:func:`cosim.core.bridge.build_bridge`).
+    def build_bridge(self) -> BridgeModel | ModalBridge:
+        """The bridge: the finite-element beam model (:func:`cosim.core.bridge.build_bridge`), or the deck given
+        by its modes (:class:`cosim.core.modal_bridge.ModalBridge`, with ``[solver] modes``/``cutoff_hz``
+        keeping the first of them).
 
         Raises:
             ConfigError, ModelError: the section or the model cannot be built (e.g. a
@@ -455,6 +512,24 @@ class Scenario(ConfigModel):
                 scenario and the table.
         """
         bridge = self.bridge
+        if bridge.is_modal:
+            return self.build_modal_bridge()
+        return self.build_beam()
+
+    def build_modal_bridge(self) -> ModalBridge:
+        """The deck given by its modes (``[bridge] modes``), placed in the bridge frame, with the modes the run
+        keeps (``[solver] modes``/``cutoff_hz``) and ``[bridge.damping]`` (else the file's ``zeta``)."""
+        bridge = self.bridge
+        with self.named("bridge"):
+            deck = bridge.deck.select(self.solver.modes, self.solver.cutoff_hz)
+            damping = bridge.damping.to_damping() if bridge.damping is not None else None
+            return ModalBridge(deck, damping, placement="the bridge frame (the modes file's points)")
+
+    def build_beam(self) -> BridgeModel:
+        """The finite-element beam model (:func:`cosim.core.bridge.build_bridge`)."""
+        bridge = self.bridge
+        if bridge.is_modal:
+            raise ConfigError(f"{self._source}: bridge: a deck given by its modes ({bridge.modes}) has no beam model")
         section = self.build_section()
         with self.named("bridge"):
             return build_bridge(
@@ -463,9 +538,16 @@ class Scenario(ConfigModel):
                 material=self.material(),
                 section=section,
                 supports=bridge.supports,
-                damping=bridge.damping.to_damping() if bridge.damping is not None else None,
+                damping=bridge.damping.beam_damping() if bridge.damping is not None else None,
                 theory=bridge.theory(),
             )
+
+    @property
+    def modes_path(self) -> Path | None:
+        """The modes file of ``[bridge] modes`` (resolved against the scenario's folder), or None."""
+        if self.bridge.modes is None:
+            return None
+        return Path(self._base_dir) / self.bridge.modes
 
     @property
     def road_profile_path(self) -> Path | None:
@@ -545,7 +627,7 @@ class Scenario(ConfigModel):
         if records is not None and records.wander == "none":
             return tuple(sorted({lane.y for lane in records.lanes}))
         if self.traffic is not None:
-            y_min, y_max = self.bridge.section.deck_y
+            y_min, y_max = self.bridge.deck_y
             n = int(math.floor((y_max - y_min) / SUMO_PATH_SPACING)) + 1
             return tuple(float(v) for v in y_min + SUMO_PATH_SPACING * np.arange(n))
         return tuple(sorted({v.y for v in self.vehicles})) or (0.0,)

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from cosim.core.bridge import BridgeModel
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import FrameSink, TrafficSource
 from cosim.errors import ConfigError, ModelError, SumoError
@@ -115,7 +116,7 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
     config = scenario.sumo_config_path
     assert config is not None
     length = scenario.bridge.length
-    deck_y = scenario.bridge.section.deck_y
+    deck_y = scenario.bridge.deck_y
     with scenario.named("traffic.sumo_config"):
         demand = read_demand(config)
         net = net_path(config)
@@ -229,7 +230,7 @@ def simulate_scenario(
     scenario: Scenario,
     progress: Callable[[float], None] | None = None,
     *,
-    bridge: BridgeModel | None = None,
+    bridge: BridgeModel | ModalBridge | None = None,
 ) -> SimulationResult:
     """Run a scenario in memory: its bridge, traffic (scripted or SUMO), road, solver and sensors.
 

@@ -23,6 +23,7 @@ from pydantic import (
     Strict,
     TypeAdapter,
     ValidationError,
+    ValidationInfo,
     create_model,
     model_serializer,
     model_validator,
@@ -645,12 +646,13 @@ class SolverConfig(ConfigModel):
 
     @model_validator(mode="before")
     @classmethod
-    def _scheme_defaults(cls, data: Any) -> Any:
+    def _scheme_defaults(cls, data: Any, info: ValidationInfo) -> Any:
         if isinstance(data, dict):
             data = dict(data)
             if data.get("scheme") == "hht":
                 data.setdefault("hht_alpha", DEFAULT_HHT_ALPHA)
-            if data.get("basis") == "modal" and "cutoff_hz" not in data:
+            every = isinstance(info.context, dict) and info.context.get("all_modes")  # a deck given by its modes
+            if data.get("basis") == "modal" and "cutoff_hz" not in data and not every:
                 data.setdefault("modes", DEFAULT_MODAL_MODES)
         return data
 

@@ -118,7 +118,7 @@ def paper_case(dt: float) -> StudyResult:
 
     Also the moving-force model for comparison and the asymmetric section (informational).
     """
-    bridge = load_scenario("paper-double-tee").build_bridge()
+    bridge = load_scenario("paper-double-tee").build_beam()
     res = paper_runs(bridge, dt, [("qc", "direct", False), ("qc_modal", "modal", False), ("mf", "direct", True)])
     reference = (
         "Direct (full FE) basis as the reference for the modal basis; the set-up of the source paper "
@@ -170,7 +170,7 @@ def paper_case(dt: float) -> StudyResult:
     ))
 
     # The asymmetric variant: informational peaks, one figure (the symmetric section for comparison).
-    asym_bridge = load_scenario("paper-double-tee-asymmetric").build_bridge()
+    asym_bridge = load_scenario("paper-double-tee-asymmetric").build_beam()
     asym = paper_runs(asym_bridge, dt, [("qc", "direct", False)])["qc"]
     rows = [(node, signed_y(y), f"{1e3 * np.min(asym[node]):.4f}", f"{1e3 * np.min(res['qc'][node]):.4f}",
              f"{np.min(asym[node]) / np.min(res['qc'][node]):.4f}") for node, y in PAPER_NODES]

@@ -186,7 +186,7 @@ def paper_torsion_theories(dt: float) -> StudyResult:
     """
     scenario = load_scenario("paper-double-tee")
     cfg = scenario.bridge
-    damping = cfg.damping.to_damping() if cfg.damping is not None else None
+    damping = cfg.damping.beam_damping() if cfg.damping is not None else None
     section = scenario.build_section()
     theories = ("vlasov", "benscoter")
     results, rows, values = {}, [], {}
