@@ -464,7 +464,8 @@ class CoupledSystem:
         fleet = kernels.Fleet(self._kind, self._params, self._weight, self._vstate, self._lifted)
         kin = kernels.Kinematics(
             np.ascontiguousarray(block.x, dtype=float), np.ascontiguousarray(block.v, dtype=float),
-            np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x))
+            np.ascontiguousarray(block.a, dtype=float), y, np.ascontiguousarray(r), np.ascontiguousarray(r_x),
+            *self._path(block))
         self._counters[3] = 0
         few = self._complete is not None and q <= DirectBasis.COMPLETE_MODAL_MAX_VEHICLES
         self._switch_engine("complete-modal" if few else "basis")
@@ -483,13 +484,20 @@ class CoupledSystem:
         return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
                            out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block), block.loads)
 
+    def _path(self, block: TrafficBlock) -> tuple[np.ndarray, ...]:
+        """The block's per-step paths for a deck given by its modes (a beam reads each wheel's ``y``)."""
+        if block.path is None or self._deck.kind == kernels.BEAM_DECK:
+            return ()
+        return (np.ascontiguousarray(block.path, dtype=float),)
+
     def _beside_surface(self, block: TrafficBlock) -> npt.NDArray[np.bool_]:
         """The block's steps at which a wheel was over the deck's length but beside its surface (it loaded
         nothing then), counted: an event each time a wheel goes there, and every such wheel-step."""
         K, q = block.x.shape
+        lateral = np.broadcast_to(block.y, block.x.shape) if block.path is None else block.path[:, :, 0]
         if isinstance(self.bridge, ModalBridge):  # the surface's edge may depend on x (skewed, curved decks)
             over = kernels.on_deck(block.x, self.bridge.length)
-            covered = self.bridge.covers(block.x, np.broadcast_to(block.y, block.x.shape))
+            covered = self.bridge.covers(block.x, lateral)
             beside = (over & ~covered).any(axis=0)
         else:
             beside = ~self.on_surface(block.y)
@@ -498,7 +506,7 @@ class CoupledSystem:
             cols = np.flatnonzero(beside)
             off[:, cols] = kernels.on_deck(block.x[:, cols], self.bridge.length)
             if isinstance(self.bridge, ModalBridge):
-                off[:, cols] &= ~self.bridge.covers(block.x[:, cols], np.broadcast_to(block.y[cols], (K, len(cols))))
+                off[:, cols] &= ~self.bridge.covers(block.x[:, cols], lateral[:, cols])
             self.offdeck_steps += int(off.sum())
             before = np.array([self._off.get(block.ids[j], False) for j in cols])
             went = np.diff(np.vstack([before[None, :], off[:, cols]]).astype(np.int8), axis=0) > 0

@@ -444,6 +444,7 @@ def simulate(
             raise ConfigError('[solver] method = "quasi-static" needs the beam model\'s influence lines; a deck given '
                               'by its modes runs with method = "dynamic"')
         bridge = bridge.keep(solver.modes, solver.cutoff_hz)
+        traffic.follow_paths()  # a curved lane's wheels load the mode surface where they are at every step
         solver = replace(solver, basis="modal", modes=None, cutoff_hz=None)
     if solver.method == "quasi-static":
         assert isinstance(bridge, BridgeModel)

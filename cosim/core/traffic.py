@@ -129,6 +129,9 @@ class TrafficBlock:
             (on the approach road, rigid ground).
         y: lateral offsets (q,), m.
         loads: the :class:`LoadRecord` of each vehicle that comes onto the deck for the first time in the block.
+        path: None (each contact point keeps ``y`` through the block), or (K, q, 5) its path at every step when
+            the source follows paths (:meth:`TrafficSource.follow_paths`): y (m), the tangent d(x, y)/dx and its
+            derivative d2(x, y)/dx2 (1/m), for a deck whose surface reads them (a deck given by its modes).
     """
 
     ids: tuple[str, ...]
@@ -138,6 +141,7 @@ class TrafficBlock:
     a: npt.NDArray[np.float64]
     y: npt.NDArray[np.float64]
     loads: tuple[LoadRecord, ...] = ()
+    path: npt.NDArray[np.float64] | None = None
 
     @classmethod
     def from_frame(cls, frame: TrafficFrame) -> TrafficBlock:
@@ -146,7 +150,7 @@ class TrafficBlock:
     def same_fleet(self, other: TrafficBlock) -> bool:
         """The same vehicles, models and lateral offsets (to the bit): the two blocks can be advanced as one."""
         return self.ids == other.ids and self.models == other.models and (
-            self.y is other.y or np.array_equal(self.y, other.y))
+            self.y is other.y or np.array_equal(self.y, other.y)) and (self.path is None) == (other.path is None)
 
     @staticmethod
     def join(blocks: list[TrafficBlock]) -> TrafficBlock:
@@ -154,7 +158,9 @@ class TrafficBlock:
         first = blocks[0]
         return TrafficBlock(first.ids, first.models, np.concatenate([b.x for b in blocks]),
                             np.concatenate([b.v for b in blocks]), np.concatenate([b.a for b in blocks]), first.y,
-                            tuple(r for b in blocks for r in b.loads))
+                            tuple(r for b in blocks for r in b.loads),
+                            None if first.path is None else np.concatenate([b.path for b in blocks
+                                                                            if b.path is not None]))
 
 
 class TrafficSource(abc.ABC):
@@ -182,11 +188,28 @@ class TrafficSource(abc.ABC):
     def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         """The vehicles on the deck at any of ``times`` (s, increasing), with their kinematics at each."""
 
+    def follow_paths(self) -> None:  # noqa: B027 - a no-op by default: most sources' wheels keep their y
+        """From now on, blocks carry each contact point's lateral path at every step (a deck given by its
+        modes reads a curved lane's path: docs/theory.md §13.4). Sources whose vehicles keep their lateral
+        offset (scripted vehicles, records) have nothing more to say and ignore it; sources of frames
+        (:class:`FramedSource`) follow."""
+
     def quiet_until(self, t: float) -> float:
         """A time (s) such that no block of times after ``t`` and before it holds a vehicle: the run may step
         through that stretch with empty blocks without asking (a stream of records between two vehicles). The
         next block asked for then starts later than the one before ended. By default ``t``: nothing promised."""
         return t
+
+
+class FramedSource(TrafficSource):
+    """A source of vehicles sampled in frames (SUMO's steps, live or logged): between frames a wheel may change
+    its lateral offset, so its blocks can carry each wheel's path (:attr:`TrafficBlock.path`) when asked."""
+
+    #: Whether blocks carry each contact point's path at every step.
+    follows_paths: bool = False
+
+    def follow_paths(self) -> None:
+        self.follows_paths = True
 
 
 class FrameSink(Protocol):
@@ -437,7 +460,7 @@ def unpack_frames(packed: tuple[Any, ...]) -> list[Any]:
     return out
 
 
-class FrameTraffic(TrafficSource):
+class FrameTraffic(FramedSource):
     """Traffic given as frames at a fixed step (from SUMO, or replayed from a log).
 
     Between two frames a vehicle moves with constant acceleration, as SUMO's
@@ -558,9 +581,14 @@ class FrameTraffic(TrafficSource):
         rows = np.where(on_kept.any(axis=0), on_kept, rows)
         last = rows.shape[0] - 1 - np.argmax(rows[::-1], axis=0)
         Y = FY[1:][r_of][last, keep] if len(keep) else np.zeros(0)
+        path = None
+        if self.follows_paths:
+            before = self._frame_at(k_lo - 1) if k_lo - 1 >= self._first else None
+            path = lateral_paths(FX[:, keep], FY[:, keep], seen[:, keep], np.ascontiguousarray(X), r_of,
+                                 *_frame_before(before, ids, keep))
         return TrafficBlock(
             tuple(ids[c] for c in keep.tolist()), tuple(models[type_of[c]] for c in keep.tolist()),
-            np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y, loads,
+            np.ascontiguousarray(X), np.ascontiguousarray(V), np.ascontiguousarray(A), Y, loads, path,
         )
 
     def _records_of(self, contact_ids: list[str]) -> tuple[LoadRecord, ...]:
@@ -579,6 +607,61 @@ class FrameTraffic(TrafficSource):
         owners = [vehicle_of(i) for i in ids]
         chosen = {o for o, w in zip(owners, wanted.tolist()) if w}
         return np.array([o in chosen for o in owners], dtype=bool)
+
+
+def _frame_before(frame: Frame | None, ids: list[str], keep: npt.NDArray[np.int64]
+                  ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+    """x, y and presence of the kept contact points in the frame before the block's first (for the first
+    interval's quadratic)."""
+    q = len(keep)
+    x, y, seen = np.zeros(q), np.zeros(q), np.zeros(q, dtype=bool)
+    if frame is not None and q:
+        where = {vid: i for i, vid in enumerate(frame.ids)}
+        for j, c in enumerate(keep.tolist()):
+            i = where.get(ids[c])
+            if i is not None:
+                x[j], y[j], seen[j] = frame.x[i], frame.y[i], True
+    return x, y, seen
+
+
+@compiled(nogil=True)
+def lateral_paths(FX: np.ndarray, FY: np.ndarray, seen: np.ndarray, X: np.ndarray, r_of: np.ndarray,
+                  x_before: np.ndarray, y_before: np.ndarray, seen_before: np.ndarray) -> np.ndarray:
+    """Each contact point's path at every step, (K, q, 5): y, 1, dy/dx, 0, d2y/dx2 (docs/theory.md §13.4).
+
+    Between frames r and r + 1 the lateral offset is the quadratic in x through the frames r - 1, r and r + 1
+    (the frame before the block for r = 0): exact on a parabola, O(h^3) times the lane's third derivative on any
+    smooth lane, h the distance driven in a frame; a straight lane gives its y and zero slope and curvature
+    exactly. Without a frame r - 1 (the vehicle just appeared) the path is the straight line through r and
+    r + 1; without r + 1 (it left) it keeps frame r's y."""
+    K, q = X.shape
+    out = np.zeros((K, q, 5))
+    for k in range(K):
+        r = r_of[k]
+        for j in range(q):
+            out[k, j, 1] = 1.0
+            if not seen[r, j]:
+                out[k, j, 0] = FY[r + 1, j] if seen[r + 1, j] else 0.0
+                continue
+            x0, y0 = FX[r, j], FY[r, j]
+            if not seen[r + 1, j] or FX[r + 1, j] == x0:
+                out[k, j, 0] = y0
+                continue
+            x1, y1 = FX[r + 1, j], FY[r + 1, j]
+            s1 = (y1 - y0) / (x1 - x0)
+            if r > 0:
+                has_m, xm, ym = seen[r - 1, j], FX[r - 1, j], FY[r - 1, j]
+            else:
+                has_m, xm, ym = seen_before[j], x_before[j], y_before[j]
+            curv = 0.0
+            if has_m and xm != x0 and xm != x1:
+                sm = (y0 - ym) / (x0 - xm)
+                curv = 2.0 * (s1 - sm) / (x1 - xm)  # the quadratic's second derivative
+            xx = X[k, j]
+            out[k, j, 0] = y0 + (xx - x0) * (s1 + 0.5 * curv * (xx - x1))
+            out[k, j, 2] = s1 + 0.5 * curv * (2.0 * xx - x0 - x1)
+            out[k, j, 4] = curv
+    return out
 
 
 @compiled(nogil=True)

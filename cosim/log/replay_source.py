@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cosim.core.traffic import Frame, FrameTraffic, LoadRecord, TrafficBlock, TrafficSource
+from cosim.core.traffic import Frame, FramedSource, FrameTraffic, LoadRecord, TrafficBlock
 from cosim.core.vehicles import model_from_dict
 from cosim.errors import ConfigError, LogError
 
@@ -138,7 +138,7 @@ def read_traffic(path: str | os.PathLike[str], length: float, step: float, until
     return traffic_from_log(contents, length, step, until), len(contents.messages.get(TOPIC_TRAFFIC, []))
 
 
-class LoggedTraffic(TrafficSource):
+class LoggedTraffic(FramedSource):
     """The logged SUMO frames of a log as a traffic source, read from the file as the run needs them.
 
     Memory stays constant however long the log: frames are read chunk by
@@ -219,6 +219,7 @@ class LoggedTraffic(TrafficSource):
                 self._feed.pad(min(need, self.until) + 0.5 * step - 1e-9)
                 if not self._waiting and self._exhausted and traffic.last_time < need - 1e-9:
                     break  # past the replay's end: FrameTraffic says so
+        traffic.follows_paths = self.follows_paths
         out = traffic.block(times)
         traffic.forget_before(need)
         return out

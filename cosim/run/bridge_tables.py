@@ -390,6 +390,7 @@ class BridgeConfig(ConfigModel):
 
     #: The modes file's deck once the scenario has read it (:meth:`cosim.run.scenario.Scenario.modal_deck`).
     _deck: ModalDeck | None = PrivateAttr(default=None)
+    _axis: tuple[tuple[float, float], tuple[float, float]] | None = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _beam_or_modes(self) -> BridgeConfig:
@@ -417,6 +418,15 @@ class BridgeConfig(ConfigModel):
     def is_modal(self) -> bool:
         """Whether the bridge is a deck given by its modes (``modes``)."""
         return self.modes is not None
+
+    def keep_axis(self, axis: tuple[tuple[float, float], tuple[float, float]]) -> None:
+        """Keep the axis a network-frame deck was placed on (network coordinates, x = 0 to its end)."""
+        self._axis = axis
+
+    @property
+    def network_axis(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The axis in network coordinates a ``frame = "network"`` deck was placed on, else None."""
+        return self._axis
 
     def keep_deck(self, deck: ModalDeck) -> None:
         """Keep the modes file's deck, read (and checked) by the scenario, which knows the file's folder."""

@@ -52,7 +52,8 @@ from pydantic import (
 )
 
 from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, build_bridge
-from cosim.core.modal_bridge import ModalBridge
+from cosim.core.modal_bridge import ModalBridge, place_deck
+from cosim.core.modal_deck import ModalDeck
 from cosim.core.records_traffic import RecordsCheck, RecordTraffic, check_records
 from cosim.core.roughness import (
     RoadProfile,
@@ -246,18 +247,57 @@ class Scenario(ConfigModel):
         if self.solver.method == "quasi-static":
             raise fail('a deck given by its modes runs with method = "dynamic" (the quasi-static method uses the '
                        "beam model's influence lines)", "solver", "method")
+        if bridge.frame == "network":
+            deck, axis = self._placed(deck, Path(base))
+            bridge.keep_axis(axis)
         bridge.keep_deck(deck)
-        if bridge.frame == "bridge":
+        try:  # the deck is in the bridge frame now, wherever its points were given
+            built = self.build_modal_bridge()
+        except ConfigError as exc:
+            raise fail(str(exc).split(": bridge: ", 1)[-1], "bridge", "modes") from None
+        for i, sensor in enumerate(self.sensors):
             try:
-                built = self.build_modal_bridge()
+                built.sensor_row(sensor.to_sensor())
             except ConfigError as exc:
-                raise fail(str(exc).split(": bridge: ", 1)[-1], "bridge", "modes") from None
-            for i, sensor in enumerate(self.sensors):
-                try:
-                    built.sensor_row(sensor.to_sensor())
-                except ConfigError as exc:
-                    raise fail(str(exc), "sensors", i) from None
+                raise fail(str(exc), "sensors", i) from None
         return self
+
+    def _placed(self, deck: ModalDeck, base: Path) -> tuple[ModalDeck, tuple[tuple[float, float],
+                                                                               tuple[float, float]]]:
+        """A network-frame deck moved into the bridge frame (docs/modal-decks.md#frames): the bridge runs along
+        ``[traffic] axis`` (its direction), else along the lanes of ``[traffic] edges``; x = 0 at the deck's first
+        point along it. Returns the deck and the axis in network coordinates, from x = 0 to the deck's end."""
+        traffic = self.traffic
+        assert traffic is not None
+        if traffic.axis is not None:
+            start, end = (np.asarray(p, dtype=float) for p in traffic.axis)
+        elif traffic.edges:
+            from cosim.sumo.network import locate_bridge, net_path
+
+            config = self.sumo_config_path_in(base)
+            try:
+                located = locate_bridge(net_path(config), traffic.edges).axis
+            except ConfigError as exc:
+                raise fail(str(exc), "traffic", "edges") from None
+            start, end = np.asarray(located.start, dtype=float), np.asarray(located.end, dtype=float)
+        else:
+            raise fail('frame = "network" needs the bridge\'s direction: give [traffic] edges (the deck\'s edges) '
+                       "or axis", "bridge", "frame")
+        along = (end - start) / float(np.linalg.norm(end - start))
+        x = (deck.points[:, 0] - start[0]) * along[0] + (deck.points[:, 1] - start[1]) * along[1]
+        origin = start + float(x.min()) * along
+        placed = place_deck(deck, (float(origin[0]), float(origin[1])), (float(along[0]), float(along[1])))
+        far = origin + float(np.ptp(x)) * along
+        return placed, ((float(origin[0]), float(origin[1])), (float(far[0]), float(far[1])))
+
+    def sumo_config_path_in(self, base: Path) -> Path:
+        """``[traffic] sumo_config`` resolved (a bundled level, or a file relative to ``base``)."""
+        assert self.traffic is not None and self.traffic.sumo_config is not None
+        if self.traffic.bundled:
+            from cosim.sumo.adapter import bundled_networks
+
+            return bundled_networks() / f"{self.traffic.sumo_config}.sumocfg"
+        return base / self.traffic.sumo_config
 
     @model_validator(mode="after")
     def _sensors_on_deck(self) -> Scenario:
@@ -341,7 +381,8 @@ class Scenario(ConfigModel):
             raise fail(f"SUMO's step must be a whole number of solver steps: step / solver.dt = "
                         f"{number_text(traffic.step)} / {number_text(self.solver.dt)} = {ratio:.6g}", "traffic", "step")
         length = self.bridge.length
-        if traffic.axis is not None and abs(math.dist(*traffic.axis) - length) > 1e-3:
+        network_deck = self.bridge.is_modal and self.bridge.frame == "network"  # the axis gives a direction only
+        if traffic.axis is not None and not network_deck and abs(math.dist(*traffic.axis) - length) > 1e-3:
             raise fail(f"the axis is {math.dist(*traffic.axis):.6g} m long; it must be the bridge's length, "
                         f"{length:g} m", "traffic", "axis")
         if not traffic.bundled:
@@ -523,7 +564,11 @@ class Scenario(ConfigModel):
         with self.named("bridge"):
             deck = bridge.deck.select(self.solver.modes, self.solver.cutoff_hz)
             damping = bridge.damping.to_damping() if bridge.damping is not None else None
-            return ModalBridge(deck, damping, placement="the bridge frame (the modes file's points)")
+            axis = bridge.network_axis
+            placement = ("the bridge frame (the modes file's points)" if axis is None else
+                         f"network coordinates, placed on the axis ({axis[0][0]:.3f}, {axis[0][1]:.3f}) -> "
+                         f"({axis[1][0]:.3f}, {axis[1][1]:.3f})")
+            return ModalBridge(deck, damping, placement=placement)
 
     def build_beam(self) -> BridgeModel:
         """The finite-element beam model (:func:`cosim.core.bridge.build_bridge`)."""
@@ -637,11 +682,7 @@ class Scenario(ConfigModel):
         """The SUMO config of ``[traffic]`` (a bundled level or a file relative to the scenario), or None."""
         if self.traffic is None or self.traffic.sumo_config is None:
             return None
-        if self.traffic.bundled:
-            from cosim.sumo.adapter import bundled_networks
-
-            return bundled_networks() / f"{self.traffic.sumo_config}.sumocfg"
-        return Path(self._base_dir) / self.traffic.sumo_config
+        return self.sumo_config_path_in(Path(self._base_dir))
 
     def build_road(self) -> RoadProfile:
         """The road profile, one wheel path per distinct vehicle offset (:meth:`wheel_paths`).

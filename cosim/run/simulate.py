@@ -121,10 +121,16 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
         demand = read_demand(config)
         net = net_path(config)
     location = None
+    network_axis = scenario.bridge.network_axis if scenario.bridge.is_modal else None
     with scenario.named("traffic.edges"):
         if t.edges:
-            location = locate_bridge(net, t.edges, length=length if t.axis is None else None)
-    if t.axis is not None:
+            location = locate_bridge(net, t.edges, length=length if t.axis is None and network_axis is None
+                                     else None)
+    if network_axis is not None:
+        axis = BridgeAxis(*network_axis)
+        axis_from = (f"the deck's points (frame = \"network\"), along {'[traffic] axis' if t.axis else 'the lanes'}"
+                     f" from its first point")
+    elif t.axis is not None:
         axis, axis_from = BridgeAxis(*t.axis), "given ([traffic] axis)"
     elif location is not None:
         axis, axis_from = location.axis, f"derived from edges {', '.join(t.edges)}"

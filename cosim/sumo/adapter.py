@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from cosim.core.axle_paths import AxisFrame, AxleTrails, axles_on_path, path_behind, record_fronts
-from cosim.core.traffic import Frame, FrameSink, FrameTraffic, LoadRecord, TrafficBlock, TrafficSource
+from cosim.core.traffic import Frame, FramedSource, FrameSink, FrameTraffic, LoadRecord, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
@@ -164,7 +164,7 @@ class SumoSettings:
         object.__setattr__(self, "extra_args", tuple(self.extra_args))
 
 
-class LiveSumo(TrafficSource):
+class LiveSumo(FramedSource):
     """SUMO's frames as a traffic source: what SUMO stepped in this process (:class:`SumoTraffic`) and in a
     child process (:class:`cosim.run.sumo_process.SumoProcess`) share.
 
@@ -269,6 +269,7 @@ class LiveSumo(TrafficSource):
             frames.add_frame(frame, fresh)
             if self.frame_sink is not None:
                 self.frame_sink(frame, fresh)
+        frames.follows_paths = self.follows_paths
         out = frames.block(times)
         frames.forget_before(float(times[-1]))
         return out

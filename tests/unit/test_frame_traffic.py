@@ -94,3 +94,30 @@ def test_a_vehicle_turning_off_the_deck_keeps_the_lane_it_had_on_it_for_the_bloc
                         [("c", 40.0, -1.7, 10.0, 0.0)], [("c", 40.3, -4.1, 6.0, 0.0)]])
     block = traffic.block(np.arange(1, 41) * 0.005)
     assert block.y.tolist() == [-1.7]
+
+
+def test_paths_are_the_quadratic_through_three_frames_exact_on_a_parabola_and_a_straight_lane() -> None:
+    """Followed paths (a deck given by its modes): between frames r and r + 1 the lane is the quadratic in x
+    through frames r - 1, r and r + 1 (docs/theory.md §13.4), so a parabolic lane y = c0 + c1 x + c2 x^2 comes
+    out exactly (value, slope, curvature: closed form, to round-off 1e-12) and a straight lane as its y with
+    zero slope and curvature, to the bit."""
+    c0, c1, c2 = 1.2, 0.05, 0.004
+    def lane(x: float) -> float: return c0 + c1 * x + c2 * x * x
+    traffic = FrameTraffic(STEP, 40.0, {"car": CAR})
+    traffic.follow_paths()
+    frames_of(traffic, [[("c", 20.0 * k * STEP, lane(20.0 * k * STEP), 20.0, 0.0),
+                         ("s", 15.0 * k * STEP, -1.6, 15.0, 0.0)] for k in range(1, 21)])
+    times = np.arange(1, 181) * 0.005 + 2 * STEP
+    block = traffic.block(times)
+    assert block.path is not None and block.path.shape == (180, 2, 5)
+    x = block.x[:, 0]
+    np.testing.assert_allclose(block.path[:, 0, 0], lane(x), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(block.path[:, 0, 2], c1 + 2 * c2 * x, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(block.path[:, 0, 4], 2 * c2, rtol=0, atol=1e-10)
+    assert np.all(block.path[:, :, 1] == 1.0) and np.all(block.path[:, :, 3] == 0.0)
+    assert np.all(block.path[:, 1, 0] == -1.6) and np.all(block.path[:, 1, [2, 4]] == 0.0)
+    traffic_plain = FrameTraffic(STEP, 40.0, {"car": CAR})  # not asked: no paths, the same block otherwise
+    frames_of(traffic_plain, [[("c", 20.0 * k * STEP, lane(20.0 * k * STEP), 20.0, 0.0),
+                               ("s", 15.0 * k * STEP, -1.6, 15.0, 0.0)] for k in range(1, 21)])
+    plain = traffic_plain.block(times)
+    assert plain.path is None and np.array_equal(plain.x, block.x) and np.array_equal(plain.y, block.y)
