@@ -315,6 +315,7 @@ def _metadata(scenario: Scenario, plan_scene_: ScenePlan | None, solver: SolverS
     contacts = _contact_ids(traffic)
     return {
         "version": __version__,
+        "encoding": "protobuf",  # the messages' (cosim.log.proto); logs without this key are JSON
         "kind": "replay" if replay else "run",
         "scenario": scenario.title,
         "source": scenario.source,
