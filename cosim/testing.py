@@ -55,6 +55,7 @@ from cosim.core.quasistatic import QuasiStaticResult, quasi_static
 from cosim.errors import ConfigError
 from cosim.run.config_base import load_config
 from cosim.run.scenario import Scenario, load_scenario, parse_scenario
+from cosim.run.simulate import scripted_traffic
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -306,10 +307,10 @@ class Results:
             from cosim.log.replay_source import read_traffic
 
             traffic_cfg = self.scenario.traffic
-            if traffic_cfg is not None:  # the logged SUMO frames (empty ones are not in the log)
+            if traffic_cfg is not None and traffic_cfg.sumo:  # the logged SUMO frames (empty ones are not logged)
                 traffic, _ = read_traffic(self.log_path, self.bridge.length, traffic_cfg.step, until=self.duration)
                 return traffic
-        return self.scenario.build_vehicles()
+        return scripted_traffic(self.scenario)
 
     def static(self, name: str) -> npt.NDArray[np.float64]:
         """Quasi-static samples of a sensor at :attr:`t` (NaN for velocity and acceleration sensors)."""

@@ -138,9 +138,37 @@ def _sumo_lines(plan: SumoPlan) -> list[str]:
     return lines
 
 
+def _records_line(scenario: Scenario) -> str:
+    """``[traffic.records]``: the file, its window, its lanes and how its vehicles are driven."""
+    records = scenario.records
+    assert records is not None
+    check = scenario.records_check()
+    summary = check.summary
+    counts = dict(check.per_lane)
+    lanes = ", ".join(f"{lane.lane} (y = {lane.y:+.3f} m, {lane.direction}, {counts.get(lane.lane, 0)} records)"
+                      for lane in records.lanes)
+    window = ("the whole file" if records.begin == 0 and records.end is None else
+              f"{fmt_g(records.begin)} s to " + (f"{fmt_g(records.end)} s" if records.end is not None else "its end"))
+    if records.via == "scripted":
+        axles = ("moving forces" if records.axle_model == "moving-force" else
+                 "tyre quarter-cars on cosim's library suspensions")
+        how = f"each driven at its recorded time, lane and speed (no SUMO), its axles {axles}"
+    else:
+        how = "each inserted into SUMO upstream of the deck to reach it at its recorded time, lane and speed"
+    wander = "no wander" if records.wander == "none" else (
+        f"wander {records.wander}" if isinstance(records.wander, str) else f"wander sd {fmt_g(records.wander)} m") + (
+        f", seed {records.seed}" if records.seed is not None else "")
+    return (f"Records: {check.path} ({records.format}), {check.count} of its {summary.count} records in {window} "
+            f"(times from midnight of {summary.origin.isoformat()}; t = 0 at {fmt_g(records.begin)} s), lanes "
+            f"{lanes}; {how}; {wander}")
+
+
 def _vehicle_lines(scenario: Scenario, plan: SumoPlan | None = None) -> list[str]:
+    if scenario.traffic is not None and not scenario.sumo:
+        return [_records_line(scenario)]
     if scenario.traffic is not None:
-        return [_traffic_line(scenario, plan), *(_sumo_lines(plan) if plan is not None else [])]
+        records = [_records_line(scenario)] if scenario.records is not None else []
+        return [_traffic_line(scenario, plan), *records, *(_sumo_lines(plan) if plan is not None else [])]
     rows = []
     for v in scenario.vehicles:
         if v.profile is not None:
@@ -161,7 +189,7 @@ def _road_line(scenario: Scenario) -> str:
     road = scenario.road
     wheel = scenario.wheel_paths()
     paths = "y = " + ", ".join(f"{y:g}" for y in wheel) + " m"
-    if scenario.traffic is not None or len(wheel) > 6:
+    if scenario.sumo or len(wheel) > 6 or (scenario.records is not None and scenario.records.wander != "none"):
         paths = f"{len(wheel)} paths, y = {wheel[0]:g} to {wheel[-1]:g} m, each wheel on the nearest"
     if road.random:
         return (f"Road: ISO 8608 class {road.road_class}, seed {road.seed}, one profile per wheel path "
@@ -182,6 +210,8 @@ def _solver_line(scenario: Scenario, duration: float) -> str:
             basis += f" (modes below {fmt_g(solver.cutoff_hz or 0.0)} Hz)"
     if solver.duration is not None:
         how = "given"
+    elif scenario.scripted_records is not None:
+        how = f"the last record's vehicle leaves the deck at {fmt_g(scenario.records_check().leave, 6)} s, + 2 s"
     elif scenario.traffic is not None:
         how = "[traffic] end - begin"
     elif not scenario.vehicles:

@@ -42,7 +42,7 @@ from cosim.errors import ConfigError
 from .jit import compiled
 from .limits import MAX_MODE_VALUES
 
-__all__ = ["DeckGrid", "GRID_TOLERANCE", "build_grid", "contact_rows", "grid_rows", "local_coordinates",
+__all__ = ["DeckGrid", "GRID_TOLERANCE", "build_grid", "cell_rows", "contact_rows", "grid_rows", "local_coordinates",
            "tensor_grid"]
 
 #: Points within this share of the deck's extent of a grid line lie on it (a structured grid from a file
@@ -346,31 +346,32 @@ def _hermite(t: float, h: float, out: np.ndarray) -> None:
 
 
 @compiled(inline=True)
-def contact_rows(sk: np.ndarray, rk: np.ndarray, w: np.ndarray, w_s: np.ndarray, w_s_minus: np.ndarray,
-                 w_r: np.ndarray, w_sr: np.ndarray, w_sr_minus: np.ndarray, s: float, r: float, ts: float,
-                 tr: float, bs: np.ndarray, br: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
-    """One contact point's rows: out[0, j] = w, out[1, j] = dw/dt, out[2, j] = t^T H t of mode j at grid
-    coordinates (s, r), for the unit direction of travel (ts, tr) in the grid frame (docs/theory.md §13.2).
-
-    ``bs``, ``br`` (3, 4) and ``coef`` (3, 4, 4) are work arrays; ``out`` is (3, m). The point must lie on
-    the grid (the caller checks the deck's surface); beyond its ends the end cells extend.
-    """
-    e = _cell(sk, s)
-    k = _cell(rk, r)
+def cell_rows(sk: np.ndarray, rk: np.ndarray, w: np.ndarray, w_s: np.ndarray, w_s_minus: np.ndarray,
+              w_r: np.ndarray, w_sr: np.ndarray, w_sr_minus: np.ndarray, e: int, k: int, s: float, r: float,
+              ts: float, tr: float, cs: float, cr: float, bs: np.ndarray, br: np.ndarray, coef: np.ndarray,
+              out: np.ndarray) -> None:
+    """One contact point's rows from the patch of cell (e, k): out[0, j] = w, out[1, j] = dw/dt and
+    out[2, j] = t^T H t + c . grad w of mode j at grid coordinates (s, r), for the direction of travel
+    (ts, tr) and the path's curvature vector (cs, cr) = kappa n (zero on a straight path), both in the grid
+    frame (docs/theory.md §13.2). ``bs``, ``br`` (3, 4) and ``coef`` (3, 4, 4) are work arrays; ``out`` is
+    (3, m)."""
     hs = sk[e + 1] - sk[e]
     hr = rk[k + 1] - rk[k]
     xi = min(max((s - sk[e]) / hs, 0.0), 1.0)
     eta = min(max((r - rk[k]) / hr, 0.0), 1.0)
     _hermite(xi, hs, bs)
     _hermite(eta, hr, br)
-    for cs in range(4):
-        for cr in range(4):
-            coef[0, cs, cr] = bs[0, cs] * br[0, cr]
-            coef[1, cs, cr] = ts * bs[1, cs] * br[0, cr] + tr * bs[0, cs] * br[1, cr]
-            coef[2, cs, cr] = (ts * ts * bs[2, cs] * br[0, cr] + 2.0 * ts * tr * bs[1, cs] * br[1, cr]
-                               + tr * tr * bs[0, cs] * br[2, cr])
+    for a_ in range(4):
+        for b_ in range(4):
+            coef[0, a_, b_] = bs[0, a_] * br[0, b_]
+            coef[1, a_, b_] = ts * bs[1, a_] * br[0, b_] + tr * bs[0, a_] * br[1, b_]
+            coef[2, a_, b_] = (ts * ts * bs[2, a_] * br[0, b_] + 2.0 * ts * tr * bs[1, a_] * br[1, b_]
+                               + tr * tr * bs[0, a_] * br[2, b_] + cs * bs[1, a_] * br[0, b_]
+                               + cr * bs[0, a_] * br[1, b_])
     m = w.shape[2]
-    out[:, :] = 0.0
+    for o in range(3):
+        for mode in range(m):
+            out[o, mode] = 0.0
     for a in range(2):
         i = e + a
         slope = w_s if a == 0 else w_s_minus
@@ -385,6 +386,19 @@ def contact_rows(sk: np.ndarray, rk: np.ndarray, w: np.ndarray, w_s: np.ndarray,
                 for mode in range(m):
                     out[o, mode] += (c_w * w[i, j, mode] + c_s * slope[i, j, mode] + c_r * w_r[i, j, mode]
                                      + c_sr * twist[i, j, mode])
+
+
+@compiled(inline=True)
+def contact_rows(sk: np.ndarray, rk: np.ndarray, w: np.ndarray, w_s: np.ndarray, w_s_minus: np.ndarray,
+                 w_r: np.ndarray, w_sr: np.ndarray, w_sr_minus: np.ndarray, s: float, r: float, ts: float,
+                 tr: float, bs: np.ndarray, br: np.ndarray, coef: np.ndarray, out: np.ndarray) -> None:
+    """One contact point's rows on a straight path (:func:`cell_rows`, in the cell that holds (s, r)): w, dw/dt
+    and t^T H t of each mode for the unit direction of travel (ts, tr) in the grid frame.
+
+    The point must lie on the grid (the caller checks the deck's surface); beyond its ends the end cells extend.
+    """
+    cell_rows(sk, rk, w, w_s, w_s_minus, w_r, w_sr, w_sr_minus, _cell(sk, s), _cell(rk, r), s, r, ts, tr, 0.0, 0.0,
+              bs, br, coef, out)
 
 
 @compiled

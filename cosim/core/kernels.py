@@ -7,7 +7,11 @@ version of the step about ten times slower than its arithmetic (~200 us
 against ~20 us for the paper bridge with one vehicle; benchmarks/bench_step.py).
 The mathematics is docs/theory.md §6; this module is its only implementation.
 
-One loop, :func:`advance_block`, serves both bases. A contact row is stored
+One loop, :func:`advance_block`, serves both bases and both kinds of deck. The
+deck is the seam between the vehicles and the structure (:func:`deck_rows`): a
+beam line (its elements' cubics, then projected on the basis) or a surface given
+by its modes (each mode's bicubic Hermite patch, docs/theory.md §13: the rows come
+out in modal coordinates directly). A contact row is stored
 sparsely in the basis' own coordinates (``idx``: which unknowns, ``rv``: the
 values of w, w_x, w_xx there): on the direct basis the few element DOFs a
 deck point depends on, on a modal basis every mode. Only four operations
@@ -30,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .jit import compiled
+from .surface_contact import NO_SURFACE, SURFACE_DECK, surface_rows
 from .traffic import on_deck
 from .vehicles import linear, quarter_car, tyre_quarter_car
 from .vehicles.base import LINEAR, MOVING_FORCE, QUARTER_CAR, TYRE_QUARTER_CAR
@@ -49,11 +54,16 @@ BasisArrays = namedtuple("BasisArrays", [
     "kind", "n", "factor", "k_ptr", "k_ind", "k_dat", "m_ptr", "m_ind", "m_dat", "ray_a", "ray_b", "inverse",
     "reduced", "phi", "c_diag", "k_diag", "a_inv", "poly_w", "poly_t",
 ], defaults=(np.zeros((0, 0, 0)), np.zeros((0, 0, 0))))
+#: The kinds of deck: a beam line (its elements' cubics, then the basis) or a surface given by its modes.
+BEAM_DECK = 0
 #: The deck: node positions (m), per-element polynomial coefficients of w and theta_x (n_el, 14, 4), the
 #: shear centre's y (m), the length (m), the element DOFs a deck point's w depends on (from the element), and
-#: the deck surface's lateral extent (m): a wheel beyond it is off the deck (rigid ground) at any x.
-DeckArrays = namedtuple("DeckArrays", ["nodes_x", "cw", "ct", "y_s", "length", "dofs", "node_dofs", "y_lo", "y_hi"],
-                        defaults=(-np.inf, np.inf))
+#: the deck surface's lateral extent (m): a wheel beyond it is off the deck (rigid ground) at any x. ``kind``:
+#: :data:`BEAM_DECK` or :data:`SURFACE_DECK` (then ``surface`` holds it, the beam's arrays are empty and the
+#: basis is the deck's modes).
+DeckArrays = namedtuple("DeckArrays", ["nodes_x", "cw", "ct", "y_s", "length", "dofs", "node_dofs", "y_lo", "y_hi",
+                                       "kind", "surface"],
+                        defaults=(-np.inf, np.inf, BEAM_DECK, NO_SURFACE))
 #: dt (s) and the Newmark/HHT parameters.
 StepScheme = namedtuple("StepScheme", ["dt", "beta", "gamma", "alpha"])
 #: The bridge's state in basis coordinates and F_n, its non-inertial vehicle forces of the last step (HHT).
@@ -61,8 +71,9 @@ BridgeState = namedtuple("BridgeState", ["d", "v", "a", "force"])
 #: The vehicles (q): model KIND, parameters (PARAM_ROWS, q), weight (N), state (STATE_ROWS, q), lifted now.
 Fleet = namedtuple("Fleet", ["kind", "params", "weight", "vstate", "lifted"])
 #: Traffic over the block's K steps: contact point x, speed, acceleration along +x (K, q); lateral y (q);
-#: road r and its slope r_x under each wheel (K, q).
-Kinematics = namedtuple("Kinematics", ["x", "v", "a", "y", "r", "r_x"])
+#: road r and its slope r_x under each wheel (K, q); ``path`` (K, q, 5): on a curved path, each wheel's y, unit
+#: tangent (tx, ty) and curvature vector (cx, cy) per step (empty: straight along x at ``y``).
+Kinematics = namedtuple("Kinematics", ["x", "v", "a", "y", "r", "r_x", "path"], defaults=(np.zeros((0, 0, 5)),))
 #: Sensor rows in basis coordinates (s, nnz) and the time derivative each reads (0 d, 1 d', 2 d'');
 #: ``every`` (s,): read at the steps whose index is a multiple of it (NaN between); ``step0`` (1,): the index
 #: of the block's first step.
@@ -146,8 +157,9 @@ def modal_polynomials(phi: np.ndarray, deck: Any) -> tuple[np.ndarray, np.ndarra
 
 
 def with_modal_polynomials(arrays: Any, deck: Any) -> Any:
-    """A modal basis' :data:`BasisArrays` with its :func:`modal_polynomials` on ``deck``; a direct one as it is."""
-    if arrays.kind != MODAL:
+    """A modal basis' :data:`BasisArrays` with its :func:`modal_polynomials` on a beam ``deck``; a direct one, or
+    a deck given by its modes (its rows are modal already), as it is."""
+    if arrays.kind != MODAL or deck.kind != BEAM_DECK:
         return arrays
     poly_w, poly_t = modal_polynomials(arrays.phi, deck)
     return arrays._replace(poly_w=poly_w, poly_t=poly_t)
@@ -201,6 +213,19 @@ def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
             vals[i, 2, k] = s2
         elems[i] = e
         geo[i, 0], geo[i, 1], geo[i, 2] = xi, lever, L
+
+
+@compiled(inline=True)
+def deck_rows(basis, deck, kin, step, elems, vals, geo, idx, rv, pidx, prv, bs, br, coef):  # noqa: ANN001, ANN201
+    """The deck seam: every contact point's rows in the basis' coordinates (``idx``, ``rv``) and where it is
+    (``elems[i]`` < 0: off the deck). A beam deck evaluates its elements' cubics at the points and projects
+    them on the basis (:func:`contact_rows`, :func:`project_contacts`); a deck given by its modes gives the
+    rows in its modal coordinates directly (:func:`surface_rows`)."""
+    if deck.kind == SURFACE_DECK:
+        surface_rows(kin, step, deck, elems, rv, bs, br, coef)
+    else:
+        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals, geo)
+        project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv)
 
 
 # ----------------------------------------------- basis-specific operations
@@ -618,13 +643,15 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     prv = np.empty((q, 3, ndeck))
     pp = np.empty((q, ndeck))
     coef = np.empty((3, q))
+    bs = np.empty((3, 4))
+    br = np.empty((3, 4))
+    cell = np.empty((3, 4, 4))
     for step in range(kin.x.shape[0]):
         for j in range(n):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
         internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
-        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals, geo)
-        project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv)
+        deck_rows(basis, deck, kin, step, elems, vals, geo, idx, rv, pidx, prv, bs, br, cell)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
             s0, s1, s3, s2, s4, _ = _deck_dots(basis.kind, idx, rv, i, nnz, d_star, v_star, v_star, False)

@@ -34,6 +34,8 @@ from cosim.errors import ConfigError
 
 from .bridge import BridgeModel
 from .coupling import BlockReport
+from .element import ELEMENT_DOFS, NODE_DOFS
+from .jit import compiled
 from .sensors import Sensor, check_sensor_on, sensor_row
 from .traffic import AXLE_SEPARATOR, TrafficBlock, TrafficSource, vehicle_of
 
@@ -117,11 +119,81 @@ def column_weights(ids: tuple[str, ...], models: tuple[Any, ...], gravity: float
     return out
 
 
+@dataclass(frozen=True)
+class InfluencePolynomials:
+    """The sensors' influence ordinates (:func:`influence`) as one cubic in the element's xi per sensor and
+    element: ``bend[s, e] . xi^p + (y - y_S) twist[s, e] . xi^p`` (the deck's w at the shear centre and its
+    twist, docs/theory.md §5.1, dotted with ``g_s`` once for every element). A point's ordinate is then 16
+    numbers, not a 14-term row of the element's shape functions built per point: the same values (to the
+    rounding), at a few tens of nanoseconds a point.
+
+    Attributes:
+        nodes_x: the element ends, m (n_el + 1); lengths: each element's, m.
+        bend, twist: (n_sensors, n_el, 4) coefficients of xi^0 ... xi^3 (NaN rows of ``g`` as 0).
+        y_s: the shear centre's y, m.
+    """
+
+    nodes_x: npt.NDArray[np.float64]
+    lengths: npt.NDArray[np.float64]
+    bend: npt.NDArray[np.float64]
+    twist: npt.NDArray[np.float64]
+    y_s: float
+
+
+def influence_polynomials(bridge: BridgeModel, g: npt.NDArray[np.float64]) -> InfluencePolynomials:
+    """The :class:`InfluencePolynomials` of influence vectors ``g`` (rows as from :func:`influence_vectors`)."""
+    c_w, c_t, lengths = bridge.deck_coefficients
+    n_el = len(lengths)
+    dofs = NODE_DOFS * np.arange(n_el)[:, None] + np.arange(ELEMENT_DOFS)[None, :]
+    g_el = np.where(np.isnan(g), 0.0, g)[:, dofs]  # (s, e, 14)
+    return InfluencePolynomials(np.asarray(bridge.nodes_x, dtype=float), np.asarray(lengths, dtype=float),
+                                np.ascontiguousarray(np.einsum("edp,sed->sep", c_w, g_el)),
+                                np.ascontiguousarray(np.einsum("edp,sed->sep", c_t, g_el)), float(bridge.section.y_s))
+
+
+@compiled(nogil=True)
+def _static_values(x: np.ndarray, y: np.ndarray, weight: np.ndarray, on: np.ndarray, nodes_x: np.ndarray,
+                   lengths: np.ndarray, bend: np.ndarray, twist: np.ndarray, y_s: float, values: np.ndarray) -> None:
+    """``values[k, s] -= weight[j] * ordinate_s(x[k, j], y[j])`` over the columns on the deck (``on``), columns
+    in order at each step (the order numpy's sums took)."""
+    steps, q = x.shape
+    n_el = lengths.shape[0]
+    n_sensors = bend.shape[0]
+    for j in range(q):
+        lever = y[j] - y_s
+        w = weight[j]
+        for k in range(steps):
+            if not on[k, j]:
+                continue
+            xx = x[k, j]
+            lo, hi = 0, n_el  # the element: nodes_x[e] <= xx < nodes_x[e + 1] (the last holds x = L)
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if nodes_x[mid] <= xx:
+                    lo = mid
+                else:
+                    hi = mid
+            e = lo
+            xi = (xx - nodes_x[e]) / lengths[e]
+            xi = min(max(xi, 0.0), 1.0)
+            for s in range(n_sensors):
+                b = bend[s, e]
+                t = twist[s, e]
+                ordinate = (b[0] + xi * (b[1] + xi * (b[2] + xi * b[3]))
+                            + lever * (t[0] + xi * (t[1] + xi * (t[2] + xi * t[3]))))
+                values[k, s] -= w * ordinate  # the weight acts downwards
+
+
 def static_block(bridge: BridgeModel, g: npt.NDArray[np.float64], block: TrafficBlock, gravity: float,
-                 y_range: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                 y_range: tuple[float, float], polynomials: InfluencePolynomials | None = None,
+                 weights: npt.NDArray[np.float64] | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The static response of a block of traffic: sensor values (K, s), and per contact column (K, q) on the
     deck (its length and its surface), its static load there (N; 0 elsewhere) and beside the surface over the
-    deck's length (it loads nothing there). ``g``: the sensors' influence vectors (NaN rows as 0)."""
+    deck's length (it loads nothing there). ``g``: the sensors' influence vectors (NaN rows as 0);
+    ``polynomials``: theirs (:func:`influence_polynomials`) and ``weights``: the block's
+    :func:`column_weights`, when already made (a run makes the polynomials once, and a fleet's weights once
+    for the blocks it stays the same in)."""
     k, q = block.x.shape
     values = np.zeros((k, len(g)))
     if not q:
@@ -130,14 +202,12 @@ def static_block(bridge: BridgeModel, g: npt.NDArray[np.float64], block: Traffic
     span = (block.x >= 0.0) & (block.x <= bridge.length)
     surface = (block.y >= y_range[0]) & (block.y <= y_range[1])
     on = span & surface[None, :]
-    weight = column_weights(block.ids, block.models, gravity)
+    weight = weights if weights is not None else column_weights(block.ids, block.models, gravity)
     force = np.where(on, weight[None, :], 0.0)
-    rows, cols = np.nonzero(on)
-    if len(rows) and len(g):
-        ordinates = influence(bridge, g, block.x[rows, cols], block.y[cols])  # (s, p)
-        contrib = -weight[cols][None, :] * ordinates  # the weight acts downwards
-        for s in range(len(g)):
-            values[:, s] = np.bincount(rows, weights=contrib[s], minlength=k)
+    if len(g) and on.any():
+        p = polynomials if polynomials is not None else influence_polynomials(bridge, g)
+        _static_values(np.ascontiguousarray(block.x, dtype=np.float64), np.ascontiguousarray(block.y, dtype=np.float64),
+                       weight, on, p.nodes_x, p.lengths, p.bend, p.twist, p.y_s, values)
     return values, on, force, span & ~surface[None, :]
 
 
@@ -170,6 +240,7 @@ def quasi_static(
     g = influence_vectors(bridge, sensors)
     static = ~np.isnan(g[:, 0]) if len(sensors) else np.zeros(0, dtype=bool)
     g = np.where(np.isnan(g), 0.0, g)
+    polynomials = influence_polynomials(bridge, g)
     names = [s.name for s in sensors]
     n_steps = int(round(duration / dt))
     peak = np.zeros(len(sensors))
@@ -184,7 +255,7 @@ def quasi_static(
         steps = np.arange(done + 1, done + k + 1)
         times = steps * dt
         block = traffic.block(times)
-        values, on, _, _ = static_block(bridge, g, block, gravity, everywhere)
+        values, on, _, _ = static_block(bridge, g, block, gravity, everywhere, polynomials)
         if on.any():
             # Vehicles, not contact points: the axles of one vehicle ("id#k") count once, masses add up.
             rows, cols = np.nonzero(on)
@@ -240,6 +311,7 @@ class QuasiStaticSystem:
             check_sensor_on(bridge, sensor)
         self.bridge, self.sensors, self.gravity = bridge, sensors, float(gravity)
         self._g = influence_vectors(bridge, sensors)
+        self._polynomials = influence_polynomials(bridge, self._g)
         y_min, y_max = bridge.section.deck_y
         tol = 1e-9 * max(y_max - y_min, 1.0)
         self._y_range = (y_min - tol, y_max + tol)
@@ -248,11 +320,23 @@ class QuasiStaticSystem:
         self.liftoff_events = self.liftoff_steps = 0
         self.offdeck_events = self.offdeck_steps = 0
         self._off: dict[str, bool] = {}
+        self._fleet: tuple[Any, Any, np.ndarray] = ((), (), np.zeros(0))  # the last block's ids, models, weights
 
     def advance(self, block: TrafficBlock) -> BlockReport:
         """The static response at the block's steps, as a :class:`cosim.core.coupling.BlockReport`."""
-        values, on, force, off = static_block(self.bridge, self._g, block, self.gravity, self._y_range)
         k, q = block.x.shape
+        if not q:  # nothing on the deck: at rest (long runs of records are mostly this)
+            self.n_steps += k
+            self._off = {}
+            none = np.zeros((k, 0))
+            flags = np.zeros((k, 0), dtype=bool)
+            return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, flags, none, none, none,
+                               np.zeros((k, len(self.sensors))), flags, flags, block.loads)
+        fleet = self._fleet
+        if fleet[0] is not block.ids or fleet[1] is not block.models:
+            fleet = self._fleet = (block.ids, block.models, column_weights(block.ids, block.models, self.gravity))
+        values, on, force, off = static_block(self.bridge, self._g, block, self.gravity, self._y_range,
+                                              self._polynomials, fleet[2])
         if off.any():
             before = np.array([self._off.get(i, False) for i in block.ids])
             self.offdeck_events += int((np.diff(np.vstack([before[None, :], off]).astype(np.int8), axis=0) > 0).sum())
@@ -271,5 +355,5 @@ def daf(dynamic_peak: float, static_peak: float) -> float:
     return float(dynamic_peak) / float(static_peak)
 
 
-__all__ = ["QuasiStaticResult", "STATIC_QUANTITIES", "column_weights", "daf", "influence", "influence_vectors",
-           "QuasiStaticSystem", "quasi_static", "static_block"]
+__all__ = ["InfluencePolynomials", "QuasiStaticResult", "STATIC_QUANTITIES", "column_weights", "daf", "influence",
+           "influence_polynomials", "influence_vectors", "QuasiStaticSystem", "quasi_static", "static_block"]

@@ -246,9 +246,10 @@ class _Extremes:
         # run's thread in 10 min of the default run.
         col_owner = self._owners[1]
         if report.ids and self._owners[0] != report.ids:  # the same vehicles block after block: worked out once
-            # Vehicles, not contact points: the axles of one vehicle ("id#k") count once.
-            owners = np.array([vehicle_of(v) for v in report.ids])
-            col_owner = np.unique(owners, return_inverse=True)[1].astype(np.int64)
+            # Vehicles, not contact points: the axles of one vehicle ("id#k") count once. (A dict, not np.unique:
+            # the fleet changes with every vehicle of a long run of records, and sorting strings cost more.)
+            number: dict[str, int] = {}
+            col_owner = np.array([number.setdefault(vehicle_of(v), len(number)) for v in report.ids], dtype=np.int64)
             self._owners = (report.ids, col_owner)
         q = len(report.ids)
         f_min, f_max = np.full(q, np.inf), np.full(q, -np.inf)
@@ -296,6 +297,37 @@ def block_extremes(sensors: np.ndarray, s_min: np.ndarray, s_max: np.ndarray, on
                     count += 1
         most = max(most, count)
     return most
+
+
+class _EmptyBlocks:
+    """Blocks of k steps without vehicles, one per k (a stretch of traffic skipped by its ``quiet_until``)."""
+
+    def __init__(self) -> None:
+        self._made: dict[int, TrafficBlock] = {}
+        self._y = np.zeros(0)
+
+    def __call__(self, k: int) -> TrafficBlock:
+        block = self._made.get(k)
+        if block is None:
+            none = np.zeros((k, 0))
+            block = self._made[k] = TrafficBlock((), (), none, none, none, self._y)
+        return block
+
+
+def _quiet_steps(quiet: Callable[[float], float], done: int, n_steps: int, dt: float) -> int:
+    """How many steps after step ``done`` (up to ``n_steps``) the traffic says are empty: steps s with
+    ``done < s`` and ``s dt < quiet_until(done dt)``."""
+    until = quiet(done * dt)
+    if not until > (done + 1) * dt:
+        return 0
+    if math.isinf(until):
+        return n_steps - done
+    last = min(int(math.ceil(until / dt)) - 1, n_steps)
+    while last > done and last * dt >= until:
+        last -= 1
+    while last + 1 <= n_steps and (last + 1) * dt < until:
+        last += 1
+    return max(last - done, 0)
 
 
 def check_traffic_fits(bridge: BridgeModel, traffic: TrafficSource) -> None:
@@ -372,7 +404,8 @@ def simulate(
             the compiled loop, which releases the GIL, advances the bridge over
             the current one in a worker thread: two cores work at once. The
             numbers are the same either way (the traffic does not depend on the
-            bridge, and the blocks are advanced in order).
+            bridge, and the blocks are advanced in order). A quasi-static run
+            never overlaps (its step holds the GIL).
         join_blocks: consecutive blocks of the same fleet (same vehicles and lateral offsets) are advanced
             in one call of at most :data:`JOINED_STEPS` steps: each call costs the solver thread, the
             observers and the log a fixed amount of Python. The numbers are the same to the bit.
@@ -404,6 +437,10 @@ def simulate(
                                sensors=tuple(sensors))
         info = {"basis": basis.name, "n_reduced": basis.n, "scheme": scheme.name, "dt": solver.dt}
     n_steps = int(round(duration / solver.dt))
+    if solver.method == "quasi-static":
+        # The static step is numpy and Python under the GIL: handing blocks to the worker thread and back cost more
+        # than it saved (an empty day at dt = 0.1 s took 0.47 s with the overlap, 0.12 s without).
+        overlap = False
     collector = _Collector(len(sensors)) if collect else None
     extremes = _Extremes([s.name for s in sensors])
     weights = _Weights()
@@ -446,10 +483,20 @@ def simulate(
             steps = group[0][1] if len(group) == 1 else np.concatenate([s for _, s in group])
             group.clear()
             block = blocks[0] if len(blocks) == 1 else TrafficBlock.join(blocks)
-            in_flight.append((solver_thread.submit(advance, block), steps, steps * solver.dt))
+            if overlap:
+                future = solver_thread.submit(advance, block)
+            else:  # in this thread: nothing to overlap, and a hand-off to the worker and back costs
+                future = Future()
+                try:
+                    future.set_result(advance(block))
+                except BaseException as exc:  # noqa: BLE001 - raised again by finish(), as the worker's would be
+                    future.set_exception(exc)
+            in_flight.append((future, steps, steps * solver.dt))
             while len(in_flight) > (1 if overlap else 0):
                 finish(in_flight.popleft())
 
+        quiet = getattr(traffic, "quiet_until", None)  # wrapped sources (a log's) pass it on
+        empty_blocks = _EmptyBlocks()
         try:
             if overlap:
                 sys.setswitchinterval(min(switch_interval, SWITCH_INTERVAL))
@@ -457,8 +504,14 @@ def simulate(
             joined = 0
             while done < n_steps:
                 k = min(block_steps, n_steps - done)
-                steps = np.arange(done + 1, done + k + 1)
-                block = traffic.block(steps * solver.dt)  # while the worker advances the blocks before
+                free = _quiet_steps(quiet, done, n_steps, solver.dt) if quiet is not None and done else 0
+                if free >= k:  # nothing on the deck for a while: empty blocks, without asking the traffic
+                    k = min(free, JOINED_STEPS)
+                    steps = np.arange(done + 1, done + k + 1)
+                    block = empty_blocks(k)
+                else:
+                    steps = np.arange(done + 1, done + k + 1)
+                    block = traffic.block(steps * solver.dt)  # while the worker advances the blocks before
                 if group and not (join_blocks and joined + k <= JOINED_STEPS and block.same_fleet(group[-1][0])):
                     hand_over()
                     joined = 0

@@ -145,7 +145,8 @@ class TrafficBlock:
 
     def same_fleet(self, other: TrafficBlock) -> bool:
         """The same vehicles, models and lateral offsets (to the bit): the two blocks can be advanced as one."""
-        return self.ids == other.ids and self.models == other.models and np.array_equal(self.y, other.y)
+        return self.ids == other.ids and self.models == other.models and (
+            self.y is other.y or np.array_equal(self.y, other.y))
 
     @staticmethod
     def join(blocks: list[TrafficBlock]) -> TrafficBlock:
@@ -180,6 +181,12 @@ class TrafficSource(abc.ABC):
     @abc.abstractmethod
     def block(self, times: npt.NDArray[np.floating]) -> TrafficBlock:
         """The vehicles on the deck at any of ``times`` (s, increasing), with their kinematics at each."""
+
+    def quiet_until(self, t: float) -> float:
+        """A time (s) such that no block of times after ``t`` and before it holds a vehicle: the run may step
+        through that stretch with empty blocks without asking (a stream of records between two vehicles). The
+        next block asked for then starts later than the one before ended. By default ``t``: nothing promised."""
+        return t
 
 
 class FrameSink(Protocol):

@@ -68,13 +68,34 @@ def fork_possible() -> bool:
 
 @contextlib.contextmanager
 def signals_held() -> Iterator[None]:
-    """The stop signals wait (blocked, then delivered) until a message is wholly in or out of a pipe: a signal
-    handler raising in the middle of one would leave the child reading the rest of a message never sent."""
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    """The stop signals wait until a message is wholly in or out of a pipe: a signal handler raising in the
+    middle of one would leave the child reading the rest of a message never sent (both sides then wait on
+    each other for ever).
+
+    Blocking the signals in this thread is not enough: the kernel hands a process's signal to any thread
+    that does not block it (SUMO's reader, numba's workers), and Python then runs the handler in the main
+    thread at its next instruction, mask or not. So in the main thread the handlers are also swapped for
+    a recorder, and a signal that came in the meantime goes to its own handler once the message is through.
+    """
+    old_mask = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    arrived: list[int] = []
+    swapped: dict[int, Any] = {}
+    if threading.current_thread() is threading.main_thread():
+        for signum in STOP_SIGNALS:
+            if signal.getsignal(signum) is not None:  # None: a handler not set from Python, left alone
+                swapped[signum] = signal.signal(signum, lambda number, _frame: arrived.append(number))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        for signum, handler in swapped.items():
+            signal.signal(signum, handler)
+        signal.pthread_sigmask(signal.SIG_SETMASK, old_mask)
+        for signum in arrived[:1]:  # the first is the one that stops; its handler holds back any later one
+            handler = swapped[signum]
+            if callable(handler):
+                handler(signum, None)
+            elif handler == signal.SIG_DFL:
+                signal.raise_signal(signum)
 
 
 def fork_child(name: str, target: Callable[..., None], args: tuple, child_ends: tuple[Connection, ...],

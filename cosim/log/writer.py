@@ -363,7 +363,8 @@ class BlockLogger:
         self._lifted: dict[str, bool] = {}
         self._off: dict[str, bool] = {}  # wheels beside the deck's surface at the end of the last block
         self._last_x: dict[str, float] = {}  # vehicles on the deck at the end of the last block: their x
-        self._model_names: dict[str, str] = {}
+        self._model_names: dict[str, str] = {}  # the last block's vehicles' models' names
+        self._names_of: tuple[str, ...] = ()
         holes = {"t": proto.Hole(0), **{n: proto.Hole(i + 1) for i, n in enumerate(self.names)}}
         self._sensor_template = proto.FixedTemplate(recorder.spec(TOPIC_SENSORS), holes)
         self._vehicle_templates: dict[tuple[str, ...], proto.FixedTemplate] = {}
@@ -542,7 +543,8 @@ class BlockLogger:
             t = float(times[0])
             self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": vid, "event": "left",
                                              "x": self._last_x.pop(vid, 0.0)})
-            self._on[vid] = self._lifted[vid] = False
+            self._on.pop(vid, None)
+            self._lifted.pop(vid, None)
 
     def _events(self, times, report) -> None:
         """Entered/left the deck and lift-off/touch-down: transitions at any step of the block."""
@@ -570,11 +572,15 @@ class BlockLogger:
                 self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": "offdeck",
                                                  "x": float(report.x[k, j]), "y": float(report.y[j])})
         self._off = {v: bool(off[-1, j]) for j, v in enumerate(ids) if off[-1, j]} if off is not None else {}
+        # Only the vehicles on the deck are remembered (a vehicle not in them is off it): the writer holds the
+        # few on the deck, not every vehicle of a long run (a year of records is a million).
         for j, vid in enumerate(ids):
-            self._on[vid], self._lifted[vid] = bool(on[-1, j]), bool(lifted[-1, j])
             if on[-1, j]:
+                self._on[vid], self._lifted[vid] = True, bool(lifted[-1, j])
                 self._last_x[vid] = float(report.x[-1, j])
             else:
+                self._on.pop(vid, None)
+                self._lifted.pop(vid, None)
                 self._last_x.pop(vid, None)
 
     def _vehicle_template(self, ids: tuple[str, ...]) -> proto.FixedTemplate:
@@ -598,9 +604,10 @@ class BlockLogger:
     def _vehicles(self, times, kept, report) -> None:
         """One message per kept step with a vehicle on the deck; encoded per group of steps with the same fleet."""
         ids = report.ids
-        for vid, model in zip(ids, report.models):
-            if vid not in self._model_names:
-                self._model_names[vid] = getattr(model, "kind", type(model).__name__)
+        if ids != self._names_of:  # the block's vehicles' model names (the fleet's, not every vehicle's so far)
+            self._model_names = {vid: getattr(model, "kind", type(model).__name__)
+                                 for vid, model in zip(ids, report.models)}
+            self._names_of = ids
         on = report.on_deck[kept]
         rows = np.flatnonzero(on.any(axis=1))
         if not len(rows):

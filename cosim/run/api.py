@@ -173,7 +173,7 @@ def _logged_run(scenario: Scenario, out: str | os.PathLike[str] | None, csv: str
         check_not_input(csv_path, "sensor CSV", [*inputs, ("the run's log (--out)", log_path)])
         check_new_file(csv_path, "sensor CSV", force)
     # SUMO: the network and demand are read (and a wrong edge or vType reported) before anything is written.
-    plan = plan_sumo(scenario) if scenario.traffic is not None else None
+    plan = plan_sumo(scenario) if scenario.sumo else None
     if checked is not None:
         checked(scenario)
     bridge = scenario.build_bridge()

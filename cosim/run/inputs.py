@@ -1,4 +1,4 @@
-"""The input files a scenario refers to (road profile, SUMO config and the files it names).
+"""The input files a scenario refers to (road profile, WIM record file, SUMO config and the files it names).
 
 A log carries them as attachments, so that it can be replayed without the
 originals (:mod:`cosim.run.logged`, :mod:`cosim.run.replay`).
@@ -25,7 +25,8 @@ class InputFile:
 
 
 def input_files(scenario: Scenario) -> list[InputFile]:
-    """The scenario's input files (now: the road profile), with the names they get in a log.
+    """The scenario's input files (the road profile, the record file, the SUMO config and the files it names),
+    with the names they get in a log.
 
     A relative path inside the scenario's folder keeps its name (``data/road.csv``);
     any other path is stored as ``inputs/<file name>``.
@@ -33,11 +34,10 @@ def input_files(scenario: Scenario) -> list[InputFile]:
     found = []
     profile = scenario.road_profile_path
     if profile is not None and scenario.road.profile is not None:
-        written = scenario.road.profile
-        pure = PurePosixPath(written.replace("\\", "/"))
-        safe = not pure.is_absolute() and ".." not in pure.parts and not re.match(r"^[A-Za-z]:", written)
-        name = str(pure) if safe else f"inputs/{pure.name}"
-        found.append(InputFile("road.profile", written, profile, name))
+        found.append(_own_file("road.profile", scenario.road.profile, profile))
+    records = scenario.records_path
+    if records is not None and scenario.records is not None:
+        found.append(_own_file("traffic.records.file", scenario.records.file, records))
     sumo_cfg = scenario.sumo_config_path
     if sumo_cfg is not None:
         for path in sumo_input_files(sumo_cfg):
@@ -46,6 +46,14 @@ def input_files(scenario: Scenario) -> list[InputFile]:
             key = "traffic.sumo_config" if path == sumo_cfg else ""
             found.append(InputFile(key, str(path), path, f"sumo/{rel.as_posix()}"))
     return found
+
+
+def _own_file(key: str, written: str, path: Path) -> InputFile:
+    """A file a scenario key names: a relative path inside the scenario's folder keeps its name in a log, any
+    other is ``inputs/<file name>``."""
+    pure = PurePosixPath(written.replace("\\", "/"))
+    safe = not pure.is_absolute() and ".." not in pure.parts and not re.match(r"^[A-Za-z]:", written)
+    return InputFile(key, written, path, str(pure) if safe else f"inputs/{pure.name}")
 
 
 def scenario_files(scenario: Scenario) -> list[tuple[str, Path]]:

@@ -54,7 +54,7 @@ from .outputs import check_new_file
 from .payloads import damping_payload, jsonable, modes_payload, section_payload
 from .scenario import RING_DOWN, Scenario
 from .signals import StopGuard, stop_signals
-from .simulate import SOLVER_FAILURES, SumoPlan, build_traffic, likely_cause, plan_sumo
+from .simulate import SOLVER_FAILURES, SumoPlan, build_traffic, likely_cause, plan_sumo, scripted_traffic
 
 #: The metadata record holding the fatigue of the stress sensors (sensor name -> JSON of its damage).
 FATIGUE_METADATA_NAME = "fatigue"
@@ -221,6 +221,9 @@ def _check_size(scenario: Scenario, bridge: BridgeModel, solver: Any, duration: 
         key = "the replayed log's duration"
     elif scenario.solver.duration is not None:
         key = f"{scenario.source}: solver.duration"
+    elif scenario.scripted_records is not None:
+        key = (f"{scenario.source}: solver.duration (default: the last record's vehicle leaves the deck + "
+               f"{RING_DOWN:g} s)")
     elif scenario.traffic is not None:
         key = f"{scenario.source}: traffic.end"
     else:
@@ -329,7 +332,7 @@ def _metadata(scenario: Scenario, plan_scene_: ScenePlan | None, solver: SolverS
         "sensors": json.dumps([s.name for s in sensors]),
         "quantities": json.dumps([s.quantity for s in sensors]),
         "vehicles": json.dumps([v.id for v in scenario.vehicles]),
-        "traffic": "sumo" if (live_sumo or scenario.traffic is not None) else (
+        "traffic": "sumo" if (live_sumo or scenario.sumo) else "records" if scenario.scripted_records else (
             "replayed frames" if traffic is not None and not scenario.vehicles else "scripted"),
         "inputs": json.dumps({item.key: item.attachment for item in inputs if item.key}),
         "python": platform.python_version(),
@@ -395,10 +398,10 @@ def plan_run(
     started = started or datetime.datetime.now().astimezone()
     if bridge is None:
         bridge = scenario.build_bridge()
-    live_sumo = traffic is None and scenario.traffic is not None
+    live_sumo = traffic is None and scenario.sumo
     sumo_plan = plan_sumo(scenario) if live_sumo else None  # a wrong edge or vType: an error before the log exists
     if traffic is None and not live_sumo:
-        traffic = scenario.build_vehicles()
+        traffic = scripted_traffic(scenario)  # records: the whole file checked here, before the log exists
     road = scenario.build_road()
     solver = scenario.solver_settings()
     sensors = scenario.sensors_core()
@@ -484,7 +487,7 @@ def run_logged(
                 traffic = sumo.enter_context(build_traffic(
                     scenario, frame_sink=relay, plan=plan.sumo, process=_sumo_process(plan.scene, plan.writer_child)))
             elif traffic is None:
-                traffic = scenario.build_vehicles()
+                traffic = scripted_traffic(scenario)
         except KeyboardInterrupt as exc:
             guard.closing = True
             raise RunInterrupted(*interruption(exc), None) from None

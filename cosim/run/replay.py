@@ -44,7 +44,7 @@ else:  # pragma: no cover - Python 3.10
 
 
 #: The scenario keys that name input files; a replay takes each from the log's attachments only.
-FILE_KEYS: tuple[str, ...] = ("road.profile", "traffic.sumo_config")
+FILE_KEYS: tuple[str, ...] = ("road.profile", "traffic.sumo_config", "traffic.records.file")
 #: Attachments that are documents about the run, not its input files.
 DERIVED_ATTACHMENTS = frozenset({SCENARIO_ATTACHMENT, "resolved.json", "section.json", "modes.json"})
 _DRIVE = re.compile(r"^[A-Za-z]:")
@@ -207,7 +207,9 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
     logged = load_config(text, source, error=LogError)  # not TOML: the log is damaged
     record = {"log": str(overview.path), "log_scenario": overview.info.get("scenario", ""),
               "log_started": overview.info.get("started", ""), "log_status": overview.status_word}
-    sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "traffic" in logged
+    logged_traffic: dict[str, Any] = logged["traffic"] if isinstance(logged.get("traffic"), dict) else {}
+    sumo = bool(overview.counts.get(TOPIC_TRAFFIC)) or "sumo_config" in logged_traffic
+    records = not sumo and "records" in logged_traffic  # WIM records driven as recorded: run again from the file
     check_messages(overview.path, [TOPIC_SENSORS])  # the traffic frames: LoggedTraffic.check below
     covered = covered_time(overview)
     duration: float | None = None
@@ -225,13 +227,20 @@ def replay_scenario(log: str | os.PathLike[str], folder: Path, other: Scenario |
         if not sumo and scenario.duration > covered > 0:
             duration = covered  # a log cut short: its own traffic replays only as far as it reached
     else:
-        if not sumo and not logged.get("vehicles"):
+        if not sumo and not records and not logged.get("vehicles"):
             raise LogError(f"{overview.path}: the log's scenario has no [[vehicles]] and no [traffic]: "
                            "no traffic to replay")
         data = tomllib.loads(other.text)
         data.pop("traffic", None)
         data.pop("vehicles", None)
-        if not sumo:
+        if records:  # the same file, from the log's attachments
+            inputs, _ = _extract(overview, folder)
+            name = inputs.get("traffic.records.file")
+            if name is None:
+                raise LogError(f"{overview.path}: the log's scenario names a record file the log does not hold")
+            data["traffic"] = logged_traffic
+            set_key(data, "traffic.records.file", name)
+        elif not sumo:
             data["vehicles"] = logged["vehicles"]
         for item in input_files(other):
             if not item.key or item.key.startswith("traffic."):

@@ -52,6 +52,7 @@ from pydantic import (
 )
 
 from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, build_bridge
+from cosim.core.records_traffic import RecordsCheck, RecordTraffic, check_records
 from cosim.core.roughness import (
     RoadProfile,
     iso8608_profile,
@@ -84,12 +85,14 @@ from .config_base import (
     show,
     suggest,
 )
+from .records import axle_models, record_lanes
 from .tables import (
     QUANTITIES,
     ROAD_CLASSES,
     SUMO_LEVELS,
     VEHICLE_MODELS,
     OutputConfig,
+    RecordsConfig,
     RoadConfig,
     SensorConfig,
     SolverConfig,
@@ -109,6 +112,7 @@ __all__ = [
     "PlateConfig",
     "QUANTITIES",
     "ROAD_CLASSES",
+    "RecordsConfig",
     "RoadConfig",
     "SUMO_LEVELS",
     "SUPPORT_PRESETS",
@@ -177,6 +181,7 @@ class Scenario(ConfigModel):
     solver: SolverConfig = SolverConfig()
     output: OutputConfig = OutputConfig()
 
+    _records_check: RecordsCheck | None = PrivateAttr(default=None)
     _source: str = PrivateAttr(default="<scenario>")
     _text: str = PrivateAttr(default="")
     _base_dir: str = PrivateAttr(default=".")
@@ -271,6 +276,11 @@ class Scenario(ConfigModel):
             return self
         if self.vehicles:
             raise fail("give either [traffic] (SUMO) or [[vehicles]] (scripted), not both", "traffic")
+        base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
+        if traffic.records is not None:
+            self._records_fit(traffic.records, Path(base))
+        if not traffic.sumo:
+            return self
         ratio = traffic.step / self.solver.dt
         if abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) < 1:
             raise fail(f"SUMO's step must be a whole number of solver steps: step / solver.dt = "
@@ -280,12 +290,28 @@ class Scenario(ConfigModel):
             raise fail(f"the axis is {math.dist(*traffic.axis):.6g} m long; it must be the bridge's length, "
                         f"{length:g} m", "traffic", "axis")
         if not traffic.bundled:
-            base = (info.context or {}).get("base_dir", ".") if isinstance(info.context, dict) else "."
+            assert traffic.sumo_config is not None
             path = Path(base) / traffic.sumo_config
             if not path.is_file():
                 raise fail(f"file not found: {path} (a bundled level: {', '.join(SUMO_LEVELS)}; a relative path "
                             "is relative to the scenario file's folder)", "traffic", "sumo_config")
         return self
+
+    def _records_fit(self, records: RecordsConfig, base: Path) -> None:
+        """``[traffic.records]``: its file is there, its lanes lie on the deck."""
+        path = base / records.file
+        if not path.is_file():
+            raise fail(f"file not found: {path} (a relative path is relative to the scenario file's folder)",
+                       "traffic", "records", "file")
+        y_min, y_max = self.bridge.section.deck_y
+        tol_y = 1e-9 * max(y_max - y_min, 1.0)
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        for i, lane in enumerate(records.lanes):
+            if not y_min - tol_y <= lane.y <= y_max + tol_y:
+                problems.append((("traffic", "records", "lanes", i, "y"),
+                                 f"must lie on the deck, {y_min:g} <= y <= {y_max:g} m (got {show(lane.y)})"))
+        if problems:
+            raise Problems(problems)
 
     @model_validator(mode="after")
     def _rate_within_steps(self) -> Scenario:
@@ -331,6 +357,68 @@ class Scenario(ConfigModel):
     def text(self) -> str:
         """The raw TOML text the scenario was read from."""
         return self._text
+
+    @property
+    def sumo(self) -> bool:
+        """Whether the run's traffic is a SUMO simulation (``[traffic] sumo_config``)."""
+        return self.traffic is not None and self.traffic.sumo
+
+    @property
+    def records(self) -> RecordsConfig | None:
+        """The ``[traffic.records]`` table, or None."""
+        return self.traffic.records if self.traffic is not None else None
+
+    @property
+    def scripted_records(self) -> RecordsConfig | None:
+        """The records driven as recorded, without SUMO (``[traffic.records] via = "scripted"``), or None."""
+        return self.traffic.scripted_records if self.traffic is not None else None
+
+    @property
+    def records_path(self) -> Path | None:
+        """The record file of ``[traffic.records]`` (relative to the scenario's folder), or None."""
+        records = self.records
+        return None if records is None else Path(self._base_dir) / records.file
+
+    def records_check(self) -> RecordsCheck:
+        """``[traffic.records]``'s file read and checked once (every line; the lanes mapped by its lanes table,
+        times never going backwards; what its window holds), before anything is written
+        (:func:`cosim.core.records_traffic.check_records`); the same answer afterwards.
+
+        Raises:
+            ConfigError: the first bad line of the file (naming it and the line); a window without records.
+        """
+        if self._records_check is not None:
+            return self._records_check
+        records, path = self.records, self.records_path
+        if records is None or path is None:
+            raise ConfigError(f"{self._source}: the scenario has no [traffic.records]")
+        check = check_records(path, records.format, record_lanes(records), self.bridge.length, records.begin,
+                              records.window_end, key="traffic.records.lanes")
+        if check.count == 0:
+            summary = check.summary
+            window = f"begin = {number_text(records.begin)} s" + (
+                f" to end = {number_text(records.window_end)} s" if records.end is not None else " on")
+            raise ConfigError(f"{self._source}: traffic.records: no record of {path} lies in the window, {window} "
+                              f"(its {summary.count} records run from {number_text(summary.first)} to "
+                              f"{number_text(summary.last)} s after midnight of its first day, "
+                              f"{summary.origin.isoformat()}); change begin and end")
+        self._records_check = check
+        return check
+
+    def build_records(self) -> RecordTraffic:
+        """``[traffic.records]`` driven as recorded (``via = "scripted"``): a
+        :class:`cosim.core.records_traffic.RecordTraffic` on this bridge's length, not started (the file checked
+        first: :meth:`records_check`)."""
+        records = self.scripted_records
+        if records is None:
+            raise ConfigError(f'{self._source}: the scenario has no [traffic.records] with via = "scripted"')
+        check = self.records_check()
+        with self.named("traffic.records"):
+            return RecordTraffic(check.path, records.format, record_lanes(records), self.bridge.length,
+                                 begin=records.begin, end=records.window_end,
+                                 lanes_per_direction=check.lanes_per_direction,
+                                 models=axle_models(records.axle_model), wander=records.wander,
+                                 seed=records.seed if records.seed is not None else 0)
 
     @property
     def base_dir(self) -> Path:
@@ -428,6 +516,8 @@ class Scenario(ConfigModel):
         """
         if self.solver.duration is not None:
             return self.solver.duration
+        if self.scripted_records is not None:
+            return self.records_check().leave + RING_DOWN
         if self.traffic is not None:
             return self.traffic.end - self.traffic.begin
         leave = self.leave_time
@@ -446,10 +536,14 @@ class Scenario(ConfigModel):
     def wheel_paths(self) -> tuple[float, ...]:
         """Lateral offsets with a road profile of their own, sorted, m.
 
-        Scripted vehicles: their distinct offsets. SUMO traffic: paths every
-        0.5 m across the deck (a wheel uses the nearest), since lanes and
-        lateral positions come from SUMO. Otherwise ``(0.0,)``.
+        Scripted vehicles: their distinct offsets; records driven as recorded
+        without wander: their lanes'. SUMO traffic (and records with wander):
+        paths every 0.5 m across the deck (a wheel uses the nearest), since
+        lanes and lateral positions come from SUMO. Otherwise ``(0.0,)``.
         """
+        records = self.scripted_records
+        if records is not None and records.wander == "none":
+            return tuple(sorted({lane.y for lane in records.lanes}))
         if self.traffic is not None:
             y_min, y_max = self.bridge.section.deck_y
             n = int(math.floor((y_max - y_min) / SUMO_PATH_SPACING)) + 1
@@ -459,7 +553,7 @@ class Scenario(ConfigModel):
     @property
     def sumo_config_path(self) -> Path | None:
         """The SUMO config of ``[traffic]`` (a bundled level or a file relative to the scenario), or None."""
-        if self.traffic is None:
+        if self.traffic is None or self.traffic.sumo_config is None:
             return None
         if self.traffic.bundled:
             from cosim.sumo.adapter import bundled_networks

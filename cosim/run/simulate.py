@@ -110,8 +110,8 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
     from cosim.sumo.vtypes import vehicle_type
 
     t = scenario.traffic
-    if t is None:
-        raise ConfigError(f"{scenario.source}: the scenario has no [traffic]")
+    if t is None or not t.sumo:
+        raise ConfigError(f"{scenario.source}: the scenario has no SUMO traffic ([traffic] sumo_config)")
     config = scenario.sumo_config_path
     assert config is not None
     length = scenario.bridge.length
@@ -191,9 +191,9 @@ def _load_settings(scenario: Scenario, demand: Any) -> LoadSettings:
 
 def build_traffic(scenario: Scenario, frame_sink: FrameSink | None = None, plan: SumoPlan | None = None,
                   process: bool | None = None) -> TrafficSource:
-    """The scenario's traffic source, not started: for ``[traffic]``, SUMO in a child process
+    """The scenario's traffic source, not started: for ``[traffic]`` with SUMO, SUMO in a child process
     (:class:`cosim.run.sumo_process.SumoProcess`) or in this one (:class:`cosim.sumo.adapter.SumoTraffic`);
-    else its scripted vehicles (:meth:`Scenario.build_vehicles`).
+    else its scripted traffic (:func:`scripted_traffic`).
 
     Args:
         frame_sink: with SUMO, where every frame and the run's documents go (e.g. a log).
@@ -201,8 +201,8 @@ def build_traffic(scenario: Scenario, frame_sink: FrameSink | None = None, plan:
         process: SUMO in a child process (the same frames; the run's process keeps its GIL); None: where a
             child can be forked (:func:`cosim.log.process.fork_possible`).
     """
-    if scenario.traffic is None:
-        return scenario.build_vehicles()
+    if not scenario.sumo:
+        return scripted_traffic(scenario)
     from cosim.sumo.adapter import SumoTraffic  # only SUMO runs load libsumo
 
     plan = plan or plan_sumo(scenario)
@@ -214,6 +214,15 @@ def build_traffic(scenario: Scenario, frame_sink: FrameSink | None = None, plan:
 
         return SumoProcess(traffic)
     return traffic
+
+
+def scripted_traffic(scenario: Scenario) -> TrafficSource:
+    """The traffic of a scenario without SUMO, not started: its WIM records driven as recorded
+    (``[traffic.records] via = "scripted"``: :meth:`Scenario.build_records`, the file checked first) or its
+    ``[[vehicles]]`` (:meth:`Scenario.build_vehicles`)."""
+    if scenario.scripted_records is not None:
+        return scenario.build_records()
+    return scenario.build_vehicles()
 
 
 def simulate_scenario(

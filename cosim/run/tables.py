@@ -29,6 +29,7 @@ from pydantic import (
 )
 
 from cosim.analysis.fatigue import SNCurve, sn_curve, sn_curve_names
+from cosim.core.loads import FORMATS
 from cosim.core.roughness import ISO_CLASSES
 from cosim.core.sensors import SECTION_POINT_QUANTITIES, SENSOR_QUANTITIES, Sensor
 from cosim.core.simulation import METHODS, SolverSettings
@@ -71,6 +72,10 @@ __all__ = [
     "SensorConfig",
     "SolverConfig",
     "LoadsConfig",
+    "RECORD_MODELS",
+    "RECORD_VIA",
+    "RecordLaneConfig",
+    "RecordsConfig",
     "TrafficConfig",
     "CONTACTS",
     "VEHICLE_MODELS",
@@ -497,10 +502,85 @@ class LoadsConfig(ConfigModel):
     wander: Annotated[str | float, PlainValidator(_wander)] = "en1991-2"
 
 
-class TrafficConfig(ConfigModel):
-    """``[traffic]``: vehicles from a SUMO simulation (instead of scripted ``[[vehicles]]``)."""
+#: ``[traffic.records] via``: each record driven at its recorded time, lane and speed without SUMO, or inserted
+#: into ``[traffic] sumo_config``'s network.
+RECORD_VIA: tuple[str, ...] = ("scripted", "sumo")
+#: ``[traffic.records] model`` (``via = "scripted"``): each axle a tyre quarter-car on cosim's library suspension
+#: scaled to its load, or a constant force (the pure load comparisons of BTLS and influence lines).
+RECORD_MODELS: tuple[str, ...] = ("tyre-quarter-car", "moving-force")
+DEFAULT_RECORD_MODEL = "tyre-quarter-car"
 
-    sumo_config: Annotated[str, Strict(), Field(min_length=1)]
+
+class RecordLaneConfig(ConfigModel):
+    """One entry of ``[traffic.records] lanes``: a lane of the file (BTLS's number), its wheel path, its way."""
+
+    lane: PositiveInt
+    y: Number
+    direction: Annotated[str, choice(tuple(DIRECTIONS), "direction")]
+
+
+class RecordsConfig(ConfigModel):
+    """``[traffic.records]``: a WIM record file as the traffic (docs/loads.md#records-as-traffic)."""
+
+    file: Annotated[str, Strict(), Field(min_length=1)]
+    format: Annotated[str, choice(tuple(FORMATS), "record format")]
+    lanes: tuple[RecordLaneConfig, ...]
+    via: Annotated[str, choice(RECORD_VIA, "via")]
+    model: Annotated[str, choice(RECORD_MODELS, "model")] | None = None
+    wander: Annotated[str | float, PlainValidator(_wander)] = "none"
+    seed: Annotated[int, Strict(), Field(ge=0)] | None = None
+    begin: NonNegative = 0.0
+    end: Positive | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self) -> RecordsConfig:
+        problems: list[tuple[tuple[str | int, ...], str]] = []
+        if not self.lanes:
+            problems.append((("lanes",), "expected at least one lane, e.g. lanes = [{lane = 1, y = -1.875, "
+                                         "direction = \"+x\"}]"))
+        seen: dict[int, int] = {}
+        for i, lane in enumerate(self.lanes):
+            if lane.lane in seen:
+                twice = f"lane {lane.lane} is given twice (also lanes[{seen[lane.lane]}])"
+                problems.append((("lanes", i, "lane"), f"{twice}; give each of the file's lanes once"))
+            seen.setdefault(lane.lane, i)
+        if self.model is not None and self.via != "scripted":
+            problems.append((("model",), f'only used with via = "scripted" (got via = {show(self.via)}: SUMO\'s '
+                                         "vehicles carry the library suspension of their vType's vClass)"))
+        if self.wander != "none" and self.seed is None:
+            problems.append((("seed",), f"required key is missing: wander = {show(self.wander)} is drawn per vehicle "
+                                        "and needs a seed (an integer >= 0) so that it can be reproduced, "
+                                        "e.g. seed = 1"))
+        if self.seed is not None and self.wander == "none":
+            problems.append((("seed",), 'only used with a wander (wander = "en1991-2" or a standard deviation, m; '
+                                        'got wander = "none")'))
+        if self.end is not None and self.end <= self.begin:
+            problems.append((("end",), f"must be after begin = {show(self.begin)} s (got {show(self.end)})"))
+        if problems:
+            raise Problems(problems)
+        return self
+
+    @property
+    def axle_model(self) -> str:
+        """The axles' model (``via = "scripted"``), the default filled in."""
+        return self.model if self.model is not None else DEFAULT_RECORD_MODEL
+
+    @property
+    def window_end(self) -> float:
+        """``end``, or inf: the whole file."""
+        return self.end if self.end is not None else math.inf
+
+
+#: ``[traffic]`` keys of a SUMO run: not to be given without ``sumo_config``.
+SUMO_KEYS: tuple[str, ...] = ("step", "begin", "end", "seed", "axis", "edges", "loads")
+
+
+class TrafficConfig(ConfigModel):
+    """``[traffic]``: vehicles from a SUMO simulation (``sumo_config``), or from a WIM record file
+    (``[traffic.records]``: driven as recorded, or inserted into the SUMO network), instead of scripted
+    ``[[vehicles]]``."""
+
+    sumo_config: Annotated[str, Strict(), Field(min_length=1)] | None = None
     step: Positive = 0.05
     begin: NonNegative = 0.0
     end: Positive = 600.0
@@ -508,14 +588,41 @@ class TrafficConfig(ConfigModel):
     axis: tuple[NetPoint, NetPoint] | None = None
     edges: tuple[Annotated[str, Strict(), Field(min_length=1)], ...] = ()
     loads: LoadsConfig | None = None
+    records: RecordsConfig | None = None
 
     @model_validator(mode="after")
     def _times(self) -> TrafficConfig:
+        if self.sumo_config is None:
+            if self.records is None:
+                raise fail("required key is missing: give sumo_config (a SUMO simulation: a bundled level, "
+                           f"{', '.join(SUMO_LEVELS)}, or a .sumocfg) or a [traffic.records] table (a WIM record file)",
+                           "sumo_config")
+            if self.records.via == "sumo":
+                raise fail('required key is missing: records with via = "sumo" are inserted into a SUMO network: '
+                           'give sumo_config, or drive them as recorded with via = "scripted"', "sumo_config")
+            given = [k for k in SUMO_KEYS if k in self.model_fields_set]
+            if given:
+                raise fail('only used with sumo_config (SUMO traffic); records with via = "scripted" run without '
+                           "SUMO: their window is [traffic.records] begin and end", given[0])
+            return self
+        if self.records is not None and self.records.via == "scripted":
+            raise fail('records with via = "scripted" run without SUMO: remove sumo_config (and the other SUMO keys), '
+                       'or insert them into the network with via = "sumo"', "records", "via")
         if self.end <= self.begin:
             raise fail(f"must be after begin = {show(self.begin)} s (got {show(self.end)})", "end")
         if self.axis is not None and math.dist(*self.axis) <= 0:
             raise fail("the two axis points must differ", "axis")
         return self
+
+    @property
+    def sumo(self) -> bool:
+        """Whether SUMO runs (``sumo_config`` given)."""
+        return self.sumo_config is not None
+
+    @property
+    def scripted_records(self) -> RecordsConfig | None:
+        """The records driven as recorded, without SUMO (``via = "scripted"``), or None."""
+        return self.records if self.records is not None and self.records.via == "scripted" else None
 
     @property
     def bundled(self) -> bool:

@@ -29,7 +29,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
-from cosim.core.loads import CLASSES, GraveModel, VehicleLoad, draw_car, uniforms, wander
+from cosim.core.loads import CLASSES, GraveModel, VehicleLoad, draw_car, lane_wander, uniforms
 
 from .vtypes import VehicleType, loaded_vehicle_type
 
@@ -67,11 +67,7 @@ class LoadSettings:
 
     def wander_of(self, vehicle_id: str) -> float:
         """The vehicle's lateral offset within its lane, m."""
-        if self.wander == "none":
-            return 0.0
-        if self.wander == "en1991-2":
-            return wander(self.seed, vehicle_id, "en1991-2")
-        return wander(self.seed, vehicle_id, "normal", sd=float(self.wander), limit=3.0 * float(self.wander))
+        return lane_wander(self.seed, vehicle_id, self.wander)
 
 
 @dataclass(frozen=True)

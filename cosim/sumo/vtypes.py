@@ -55,6 +55,7 @@ __all__ = [
     "VehicleType",
     "axles_from_parameters",
     "check_parameter_names",
+    "library_model",
     "markdown_table",
     "model_from_parameters",
     "model_params",
@@ -177,7 +178,7 @@ def _flag(type_id: str, params: dict[str, str], key: str, default: bool) -> bool
     return value in ("true", "1")
 
 
-def _library_model(suspension: Suspension, mass: float) -> TyreQuarterCar:
+def library_model(suspension: Suspension, mass: float) -> TyreQuarterCar:
     """The suspension set scaled to a vehicle of gross ``mass`` kg."""
     m_v = mass / (1.0 + suspension.m_w)
     return TyreQuarterCar(m_v=m_v, m_w=suspension.m_w * m_v, k_v=suspension.k_v * m_v, c_v=suspension.c_v * m_v,
@@ -366,7 +367,7 @@ def vehicle_type(type_id: str, vclass: str, length: float | None, mass: float | 
         details["suspension"] = ", ".join(PARAM_PREFIX + k for k in own) + (
             f"; {', '.join(missing)} from {entry.suspension.name} ({entry.suspension.source})" if missing else "")
     else:
-        model: VehicleModel = _library_model(entry.suspension, gross)
+        model: VehicleModel = library_model(entry.suspension, gross)
         sources["suspension"] = f"{SOURCE_DEFAULT}: {entry.suspension.name}"
         details["suspension"] = entry.suspension.source
     if (PARAM_PREFIX + "axles") in params or (PARAM_PREFIX + "axle_loads") in params:

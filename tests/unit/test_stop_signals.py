@@ -1,13 +1,16 @@
 """cosim.run.signals.stop_signals with real signals sent to this process (pytest's main thread)."""
 from __future__ import annotations
 
+import multiprocessing
 import os
 import signal
+import threading
 import time
 
 import pytest
 
 from cosim.errors import Interrupted
+from cosim.log.process import signals_held
 from cosim.run.signals import stop_signals
 
 
@@ -42,3 +45,29 @@ def test_held_signals_are_recorded_not_raised_and_the_first_is_raised_when_the_b
     with stop_signals(hold=True) as guard:
         assert signal.getsignal(signal.SIGTERM) != before
     assert guard.received == 0 and signal.getsignal(signal.SIGTERM) == before  # the handlers are restored
+
+
+def test_a_signal_delivered_to_another_thread_waits_until_the_message_is_through_the_pipe() -> None:
+    """The kernel may hand the process's SIGTERM to any thread that does not block it; Python then runs the
+    handler in the main thread at its next instruction, inside a held block unless :func:`signals_held` defers
+    it. Raised between a message's header and its body (``Connection.send_bytes`` writes them separately), it
+    left a replay and its log writer each waiting on the other for hours (seen in this suite)."""
+    receiver, sender = multiprocessing.Pipe(duplex=False)
+    payload = b"x" * 40_000  # above 16 KiB: header and body are two writes (and within the pipe's 64 KiB)
+    bystander = threading.Event()
+    other = threading.Thread(target=bystander.wait)  # a thread with the stop signals unblocked
+    other.start()
+    through = []
+    try:
+        with pytest.raises(Interrupted) as stopped, stop_signals():
+            with signals_held():
+                signal.pthread_kill(other.ident, signal.SIGTERM)
+                time.sleep(0.05)  # the handler would run here, in the main thread, were it not held
+                sender.send_bytes(payload)
+                through.append(True)
+            through.append(False)  # the held signal is raised on leaving the block, before this
+    finally:
+        bystander.set()
+        other.join()
+    assert stopped.value.name == "SIGTERM" and through == [True]
+    assert receiver.poll(1) and receiver.recv_bytes() == payload  # the message arrived whole

@@ -13,7 +13,18 @@ and the core's limits only: no SUMO, no MCAP, no configuration library.
 """
 from __future__ import annotations
 
-from .draws import CAR, EN1991_2_FREQUENCIES, EN1991_2_OFFSETS, CarModel, VehicleLoad, draw_car, uniforms, wander
+from .draws import (
+    CAR,
+    EN1991_2_FREQUENCIES,
+    EN1991_2_OFFSETS,
+    WANDER_WORDS,
+    CarModel,
+    VehicleLoad,
+    draw_car,
+    lane_wander,
+    uniforms,
+    wander,
+)
 from .formats import FORMATS, Format
 from .grave import CLASSES, GraveModel, bundled_sites, load_model, read_site
 from .mixture import Mixture, Mode
@@ -21,6 +32,7 @@ from .records import RecordsSummary, VehicleRecord, btls_lane, read_records, sur
 
 __all__ = [
     "CAR", "CLASSES", "EN1991_2_FREQUENCIES", "EN1991_2_OFFSETS", "FORMATS", "CarModel", "Format", "GraveModel",
-    "Mixture", "Mode", "RecordsSummary", "VehicleLoad", "VehicleRecord", "btls_lane", "bundled_sites", "draw_car",
-    "load_model", "read_records", "read_site", "survey", "uniforms", "wander", "write_records",
+    "Mixture", "Mode", "RecordsSummary", "VehicleLoad", "VehicleRecord", "WANDER_WORDS", "btls_lane", "bundled_sites",
+    "draw_car", "lane_wander", "load_model", "read_records", "read_site", "survey", "uniforms", "wander",
+    "write_records",
 ]

@@ -200,3 +200,22 @@ def wander(seed: int, vehicle_id: str, kind: Literal["en1991-2", "normal"] = "en
     if not (isinstance(limit, (int, float)) and math.isfinite(limit) and limit > 0.0):
         raise ConfigError(f"wander: limit must be a number > 0 m (got {limit!r})")
     return _normal(0.0, float(sd), -float(limit), float(limit), "m").sampler().draw(0.0, u)
+
+
+#: What a wander setting may be (``[traffic.loads]`` and ``[traffic.records]`` ``wander``): EN 1991-2's
+#: distribution, none, or the standard deviation of a normal one (m, truncated at 3 standard deviations).
+WANDER_WORDS = ("en1991-2", "none")
+
+
+def lane_wander(seed: int, vehicle_id: str, setting: str | float) -> float:
+    """A vehicle's lateral offset within its lane (m) for a scenario's ``wander`` setting: ``"none"`` (0),
+    ``"en1991-2"`` (:func:`wander`'s EN 1991-2 Figure 4.6), or a number, the standard deviation of a normal
+    offset (m) truncated to 3 standard deviations."""
+    if setting == "none":
+        return 0.0
+    if setting == "en1991-2":
+        return wander(seed, vehicle_id, "en1991-2")
+    if isinstance(setting, str):
+        raise ConfigError(f"wander: expected {', '.join(WANDER_WORDS)} or a standard deviation in m (got {setting!r})")
+    return wander(seed, vehicle_id, "normal", sd=float(setting), limit=3.0 * float(setting))
+

@@ -23,7 +23,7 @@ import math
 import os
 import tempfile
 import zlib
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from datetime import date, timedelta
 from pathlib import Path
@@ -118,8 +118,14 @@ def record_format(name: str) -> Format:
     return fmt
 
 
-def survey(path: str | Path, format: str) -> RecordsSummary:
+def survey(path: str | Path, format: str, visit: Callable[[VehicleRecord], None] | None = None) -> RecordsSummary:
     """Read and check a whole file (every line, as :func:`read_records` does), in constant memory.
+
+    Args:
+        path, format: the file and its format.
+        visit: called with every record as it is read, if given (one pass for the file's checks and a caller's:
+            a run's lanes and window). Its ``lane`` is the file's lane within its direction: BTLS's numbers need
+            the whole file's lane counts (:attr:`RecordsSummary.lanes_per_direction`, :func:`btls_lane`).
 
     Raises:
         ConfigError: the first bad line (naming the file and the line), an empty file, too many records.
@@ -127,6 +133,8 @@ def survey(path: str | Path, format: str) -> RecordsSummary:
     path = Path(path)
     count, lanes, first, last, origin = 0, [0, 0], 0.0, 0.0, date(2000, 1, 1)
     for record in _parse(path, record_format(format), None):
+        if visit is not None:
+            visit(record)
         if count == 0:
             first, origin = record.time, record.origin
         count += 1
