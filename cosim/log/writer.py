@@ -34,7 +34,7 @@ from cosim import __version__
 from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
 from cosim.core.traffic import vehicle_of
 from cosim.core.vehicles import model_to_dict
-from cosim.errors import LogError, interruption_message
+from cosim.errors import LogError, LogWriteError, interruption_message
 
 from . import proto
 from .schemas import (
@@ -396,7 +396,7 @@ class BlockLogger:
 
     def on_block(self, times, keep, report) -> None:
         if self._error is not None:
-            raise LogError(f"{self.rec.path}: writing the log failed: {self._error}")
+            raise LogWriteError(f"{self.rec.path}: writing the log failed: {self._error}")
         frames = self._frames[:]
         self._frames.clear()  # the same list: the traffic sink appends to it
         if self._queue is None:
@@ -465,7 +465,7 @@ class BlockLogger:
             self._thread = None
         if self._error is not None:
             where = getattr(self, "_error_trace", "").strip().splitlines()
-            raise LogError(f"{self.rec.path}: writing the log failed: {self._error!r}"
+            raise LogWriteError(f"{self.rec.path}: writing the log failed: {self._error!r}"
                            + (f" ({where[-3].strip()})" if len(where) >= 3 else ""))
 
     def __enter__(self) -> BlockLogger:

@@ -235,3 +235,36 @@ def test_a_binary_road_profile_is_reported_at_its_key(tmp_path: Path) -> None:
     scenario = profiled(tmp_path)
     (tmp_path / "data/road.csv").write_bytes(bytes(range(256)) * 4)
     assert_one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", "not a text file")
+
+
+# --------------------------------------------------------------------------- issue 27, item 6: a log cut short
+
+
+def test_a_log_that_cannot_be_finished_says_up_to_when_it_can_be_read(tmp_path: Path) -> None:
+    """The disk fills during a run: here a real limit on the file size (RLIMIT_FSIZE: a write past it fails with
+    EFBIG, File too large, Python ignoring SIGXFSZ), which fails the log's writes as a full disk (ENOSPC) does,
+    in the same place. The run exits 1 with one line that names the error and the simulated time up to which the
+    file can be read: what a reader of the file finds."""
+    import resource
+    import subprocess
+    import sys
+
+    from _robust import cli_env
+
+    from cosim.log import read_log
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+
+    result = subprocess.run([sys.executable, "-m", "cosim", "run", "paper-double-tee", "--out", "cut.mcap",
+                             "--quiet"], capture_output=True, text=True, cwd=tmp_path, env=cli_env(), timeout=600,
+                            preexec_fn=limit)
+    line = assert_one_line(result, 1, "cut.mcap: writing the log failed", "File too large",
+                           "the log cut.mcap is cut short: it can be read up to t = ",
+                           "of the 20 s simulated (and has no final status)")
+    assert "finished" not in line and "status \"error\"" not in line
+    stated = float(line.split("read up to t = ")[1].split(" s")[0])
+    log = read_log(tmp_path / "cut.mcap")
+    assert log.truncated and log.final_status["state"] != "finished"
+    assert 0 < stated < 20 and max(t for t, _ in log.messages["/cosim/sensors"]) / 1e9 == stated
+    assert (tmp_path / "cut.mcap").stat().st_size <= 200_000
