@@ -8,6 +8,11 @@ e.g. by numpy imported through cosim's pytest plugin, which pytest loads
 before any conftest.
 """
 import os
+import tempfile
+
+# Solved sections go to a folder of this session's, not the user's cache (cosim.core.section_cache): a test that
+# counts solves starts from an empty cache.
+os.environ.setdefault("COSIM_CACHE_DIR", tempfile.mkdtemp(prefix="cosim-test-cache-"))
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS"):
     os.environ[_var] = "1"

@@ -25,6 +25,10 @@ class LogError(CosimError):
     """An MCAP log is missing, corrupt or not a cosim log."""
 
 
+class LogWriteError(LogError):
+    """Writing a log failed part way (a full disk, a file-size limit, an I/O error): the file is cut short."""
+
+
 class Interrupted(KeyboardInterrupt):
     """A run was stopped by a signal: SIGINT (Ctrl-C), SIGTERM or SIGHUP (a scheduler, a closed terminal).
 

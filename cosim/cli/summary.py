@@ -12,7 +12,7 @@ from typing import Any
 from cosim.core.modal_bridge import ModalBridge
 from cosim.core.traffic import vehicle_of
 from cosim.run.api import RunStart
-from cosim.run.logged import RunFailed, RunInterrupted, RunOutcome
+from cosim.run.logged import LogCutShort, RunFailed, RunInterrupted, RunOutcome
 from cosim.run.scenario import Scenario
 from cosim.run.simulate import SumoPlan
 from cosim.run.units import display_unit
@@ -382,6 +382,9 @@ class RunDisplay:
     def stopped(self, exc: RunFailed | RunInterrupted) -> int:
         """Report a run that failed or was stopped after it was set up (one line on stderr); its exit status."""
         self.close()
+        if isinstance(exc, LogCutShort):  # its own message says what the file holds
+            report_error(str(exc))
+            return EXIT_RUN_FAILED
         if isinstance(exc, RunFailed):
             report_error(f"{exc} (the run failed; its log {exc.log_path} is finished, status \"error\")")
             return EXIT_RUN_FAILED

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -151,12 +151,15 @@ class SectionField:
         elements: (n_el, 6) node ids of the quadratic triangles (corners, then the mid-sides 1-2, 2-3, 3-1).
         omega: (n,) the principal sectorial coordinate about S at the nodes, m^2.
         solved: the solved ``sectionproperties`` Section (for the shear stresses).
+        shear: :attr:`unit_shear` when it is known without ``solved`` (a section read back from a
+            :class:`SectionStore`).
     """
 
     nodes: np.ndarray
     elements: np.ndarray
     omega: np.ndarray
     solved: Any = field(default=None, repr=False)
+    shear: np.ndarray | None = field(default=None, repr=False)
 
     def locate(self, y: float, z: float) -> tuple[int, np.ndarray] | None:
         """The triangle holding the point (y, z) and the point's area coordinates there; None outside the section."""
@@ -199,6 +202,8 @@ class SectionField:
     def unit_shear(self) -> np.ndarray:
         """(n, 3, 2): shear stresses (tau_xy, tau_xz) at the nodes, Pa, per unit St Venant torque (N m) and per
         unit shear force along y and along z (N): sectionproperties' Saint-Venant and flexure solutions."""
+        if self.shear is not None:
+            return self.shear
         stress = self.solved.calculate_stress(vx=1.0, vy=1.0, mzz=1.0).get_stress()[0]
         # sectionproperties' (x, y, z) are our (y, z, x): its sig_zx is our tau_xy, its sig_zy our tau_xz.
         out = np.empty((len(self.nodes), 3, 2))
@@ -313,7 +318,7 @@ def _cache_key(rows: list[tuple[float, float, float, float, float]]) -> tuple:
 
 
 def section_from_plates(
-    plates: Sequence[Plate], nu: float = 0.2, mesh_size: float | None = None
+    plates: Sequence[Plate], nu: float = 0.2, mesh_size: float | None = None, store: SectionStore | None = None
 ) -> SectionProperties:
     """Section constants of a plate assembly from the finite-element section solver.
 
@@ -325,12 +330,15 @@ def section_from_plates(
 
     The solve is cached per process: the same plates (in any order or
     direction), ``nu`` and ``mesh_size`` return the stored result without
-    solving again (see :data:`FE_SOLVES` and ``section_from_plates.cache_info()``).
+    solving again (see :data:`FE_SOLVES` and ``section_from_plates.cache_info()``);
+    and between processes in ``store`` when one is given (scenarios use the
+    user's cache folder, :mod:`cosim.run.section_cache`).
 
     Args:
         plates: midline segments with thicknesses, m, in section (y, z) coordinates.
         nu: Poisson's ratio, dimensionless; only the shear areas depend on it.
         mesh_size: maximum triangle area, m^2; default :func:`default_mesh_size`.
+        store: solved sections kept between processes (:class:`SectionStore`); None solves in this process only.
 
     Returns:
         The section constants; ``source`` names the solver and mesh.
@@ -355,8 +363,11 @@ def section_from_plates(
     MAX_SECTION_TRIANGLES.check(
         area / mesh_size, "`mesh_size`" if given else "`mesh_size` (the default, t_min^2 / 8)",
         f"about {area:.4g} m^2 of plates / {mesh_size:.3g} m^2 per triangle; a larger mesh_size makes fewer")
-    _check_connected(rows)
-    return _solve_fe(_cache_key(rows), nu, mesh_size)
+    try:
+        return _solve_fe(_cache_key(rows), nu, mesh_size, store)
+    except _Disconnected:
+        _check_connected(rows)  # the message names the plates in the caller's order
+        raise
 
 
 def _rectangles_and_union(rows: list[tuple[float, float, float, float, float]]) -> tuple[list, Any]:
@@ -366,6 +377,16 @@ def _rectangles_and_union(rows: list[tuple[float, float, float, float, float]]) 
 
     rects = [Polygon(plate_rectangle(*r)) for r in rows]
     return rects, unary_union(rects)
+
+
+class _Disconnected(Exception):
+    """The plates of a solve are not one section (:func:`section_from_plates` says which, in the caller's order)."""
+
+
+def _connected(rows: list[tuple[float, float, float, float, float]]) -> bool:
+    from shapely.geometry import Polygon
+
+    return isinstance(_rectangles_and_union(rows)[1], Polygon)
 
 
 def _check_connected(rows: list[tuple[float, float, float, float, float]]) -> None:
@@ -385,8 +406,47 @@ def _check_connected(rows: list[tuple[float, float, float, float, float]]) -> No
     )
 
 
+class SectionStore(Hashable, Protocol):
+    """Solved plate sections kept between processes (a cache): what :func:`section_from_plates` asks before solving.
+
+    ``definition`` is the section's whole definition as text (the plates in a canonical order, ``nu`` and the mesh
+    size, floats in hexadecimal: :func:`section_definition`). A store returns exactly what was saved for it, or None;
+    it must never return a section it cannot vouch for (corrupt, another definition's). Stores are hashable values.
+    The numerical core holds no store of its own: files and folders belong to the layers above
+    (:class:`cosim.run.section_cache.SectionCache`).
+    """
+
+    def load(self, definition: str) -> SectionProperties | None:
+        """The section saved for ``definition``, or None."""
+        ...
+
+    def save(self, definition: str, section: SectionProperties) -> None:
+        """Keep a solved section (with its stress field) for ``definition``; a store that cannot, skips it."""
+        ...
+
+
+def section_definition(key: tuple, nu: float, mesh_size: float) -> str:
+    """A plate section's definition as text, for a :class:`SectionStore` (the same for the same solve)."""
+    plates = [(float(a[0]).hex(), float(a[1]).hex(), float(b[0]).hex(), float(b[1]).hex(), float(t).hex())
+              for a, b, t in key]
+    return repr(("plates", plates, "nu", float(nu).hex(), "mesh_size", float(mesh_size).hex()))
+
+
 @functools.lru_cache(maxsize=128)
-def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
+def _solve_fe(key: tuple, nu: float, mesh_size: float, store: SectionStore | None = None) -> SectionProperties:
+    """The solved section: from ``store`` when it holds it, else solved (and saved there)."""
+    definition = section_definition(key, nu, mesh_size) if store is not None else ""
+    if store is not None:
+        kept = store.load(definition)
+        if kept is not None:
+            return kept
+    solved = _solve_fe_now(key, nu, mesh_size)
+    if store is not None:
+        store.save(definition, solved)
+    return solved
+
+
+def _solve_fe_now(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
     global FE_SOLVES
     # Imported here: sectionproperties pulls in matplotlib (~1 s), which modules
     # that only need Material or constants should not pay for.
@@ -395,6 +455,9 @@ def _solve_fe(key: tuple, nu: float, mesh_size: float) -> SectionProperties:
     from sectionproperties.pre.pre import Material as SpMaterial
 
     rows = [(a[0], a[1], b[0], b[1], t) for a, b, t in key]
+    # Checked here, not before a store's answer (a stored section was solved, so connected; shapely stays unloaded).
+    if not _connected(rows):
+        raise _Disconnected
     _, polygon = _rectangles_and_union(rows)
     # E = 1 makes the modulus-weighted getters return the geometric constants
     # while the material still carries nu, which the shear areas depend on.

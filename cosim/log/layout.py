@@ -67,6 +67,7 @@ class LayoutInputs:
         contacts: the contact points' ids (scripted vehicles, known before the run), or None.
         sumo: the traffic came from SUMO (``/cosim/traffic`` holds its frames).
         scene: the log has the 3D scene; scene_length: the bridge's length, m (for the camera).
+        protobuf: the messages are protobuf (a sensor's field is :func:`cosim.log.proto.sensor_fields`' name).
     """
 
     sensors: tuple[tuple[str, str], ...]
@@ -74,6 +75,7 @@ class LayoutInputs:
     sumo: bool
     scene: bool
     scene_length: float = 0.0
+    protobuf: bool = False
 
 
 def _field(name: str) -> str:
@@ -147,10 +149,16 @@ def make_layout(inputs: LayoutInputs) -> dict[str, Any]:
     for name, quantity in inputs.sensors:
         groups.setdefault(quantity if quantity in SENSOR_UNITS else "", []).append(name)
     plots = []
+    if inputs.protobuf:  # the sensor's field in the message (its name, where that is a protobuf identifier)
+        from .proto import sensor_fields
+
+        field = dict(zip((n for n, _ in inputs.sensors), sensor_fields(n for n, _ in inputs.sensors)))
+    else:
+        field = {n: _field(n) for n, _ in inputs.sensors}
     for quantity, names in groups.items():
         key = f"Plot!{quantity or 'sensors'}"
         title = (f"{_QUANTITY_TITLES[quantity]}, {SENSOR_UNITS[quantity]}" if quantity else "sensors, SI units")
-        config[key] = _plot(title, [(f"{TOPIC_SENSORS}.{_field(n)}", n) for n in names])
+        config[key] = _plot(title, [(f"{TOPIC_SENSORS}.{field[n]}", n) for n in names])
         plots.append(key)
     contacts = inputs.contacts
     if contacts is not None and 0 < len(contacts) <= MAX_SERIES and all('"' not in c for c in contacts):
@@ -224,7 +232,7 @@ def inputs_from_metadata(info: dict[str, str], sensor_names: Sequence[str], quan
     # SUMO's frames are logged by a run with SUMO, not by a replay of one (it re-drives them).
     sumo = info.get("traffic") == "sumo" and info.get("kind") != "replay"
     return LayoutInputs(sensors=tuple(zip(sensor_names, quantities)), contacts=contacts, sumo=sumo, scene=scene,
-                        scene_length=length)
+                        scene_length=length, protobuf=info.get("encoding") == "protobuf")
 
 
 def inputs_from_log(overview: LogOverview) -> LayoutInputs:

@@ -40,7 +40,7 @@ from pathlib import Path
 from typing import Any
 
 from cosim.core.traffic import pack_frames, unpack_frames
-from cosim.errors import LogError
+from cosim.errors import LogError, LogWriteError
 
 __all__ = ["ORPHANED", "STOP_SIGNALS", "WRITER_NICENESS", "LogProcess", "fork_child", "fork_possible",
            "signals_held"]
@@ -260,7 +260,7 @@ class LogProcess:
             if kind == "error":
                 self._error = text
         if self._error is not None:
-            raise LogError(f"{self.path}: writing the log failed: {self._error}")
+            raise LogWriteError(f"{self.path}: writing the log failed: {self._error}")
 
     # ------------------------------------------------- the recorder's methods
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
@@ -312,7 +312,7 @@ class LogProcess:
                 error = error or f"the log writer process did not finish within {CLOSE_TIMEOUT:g} s"
             self._replies.close()
         if error is not None:
-            raise LogError(f"{self.path}: writing the log failed: {error}")
+            raise LogWriteError(f"{self.path}: writing the log failed: {error}")
 
     # ------------------------------------------------------ the block stream
     def block_logger(self, total_time: float, status_every: float, plan: Any = None,

@@ -41,7 +41,7 @@ from typing import IO, Literal
 
 import numpy as np
 import orjson
-from mcap.records import Channel
+from mcap.records import Channel, Schema
 
 from cosim.errors import CosimError, LogError
 
@@ -77,14 +77,8 @@ def file_is_complete(path: str | os.PathLike[str]) -> bool:
         return False
 
 
-def _decode(path: Path, channel: Channel, data: bytes) -> dict:
-    """One message as a JSON object checked against cosim's schema for its topic (the one decoder)."""
-    if channel.message_encoding != "json":
-        raise LogError(f"{path}: channel {channel.topic} is {channel.message_encoding!r}, not a cosim JSON channel")
-    try:
-        value = orjson.loads(data)  # strict JSON (no NaN): what cosim writes; 5x faster than json
-    except (orjson.JSONDecodeError, RecursionError):
-        raise LogError(f"{path}: a message on {channel.topic} is not valid JSON") from None
+def _checked(path: Path, channel: Channel, value: object) -> dict:
+    """A decoded message, checked against cosim's schema for its topic (the JSON log's, whatever the encoding)."""
     if not isinstance(value, dict):
         raise LogError(f"{path}: a message on {channel.topic} is not a JSON object")
     check = message_check(channel.topic)
@@ -95,6 +89,68 @@ def _decode(path: Path, channel: Channel, data: bytes) -> dict:
             when = f" (t = {t:g} s)" if type(t) in (int, float) else ""
             raise LogError(f"{path}: a message on {channel.topic}{when} does not match its schema: {problem}")
     return value
+
+
+def _decode_json(path: Path, channel: Channel, data: bytes) -> dict:
+    try:
+        value = orjson.loads(data)  # strict JSON (no NaN): what cosim writes; 5x faster than json
+    except (orjson.JSONDecodeError, RecursionError):
+        raise LogError(f"{path}: a message on {channel.topic} is not valid JSON") from None
+    return _checked(path, channel, value)
+
+
+class Decoder:
+    """Messages as the dictionaries cosim's JSON logs held, checked against cosim's schema for their topic: the
+    one decoder. It picks the decoding by the channel's message encoding: JSON (logs of earlier versions) or
+    protobuf (:mod:`cosim.log.proto`, with cosim's own schema for the topic: a channel whose schema is not the
+    one cosim writes is refused before any of its messages is used).
+
+    ``schemas``: the log's schema records by id, filled as the walk meets them (:func:`cosim.log.records.walk`).
+    """
+
+    def __init__(self, path: Path, schemas: dict[int, Schema]) -> None:
+        self.path = path
+        self.schemas = schemas
+        self._by_channel: dict[int, Callable[[bytes], dict]] = {}
+
+    def __call__(self, channel: Channel, data: bytes) -> dict:
+        decode = self._by_channel.get(channel.id)
+        if decode is None:
+            decode = self._by_channel[channel.id] = self._for(channel)
+        return decode(data)
+
+    def _for(self, channel: Channel) -> Callable[[bytes], dict]:
+        path = self.path
+        if channel.message_encoding == "json":
+            return lambda data: _decode_json(path, channel, data)
+        if channel.message_encoding != "protobuf":
+            raise LogError(f"{path}: channel {channel.topic} is {channel.message_encoding!r}, not a cosim JSON or "
+                           "protobuf channel")
+        from google.protobuf.message import DecodeError
+
+        from . import proto
+
+        topic = channel.topic
+        expected = proto.TOPIC_MESSAGES.get(topic)
+        if expected is None:
+            raise LogError(f"{path}: channel {topic} is not a cosim topic")
+        schema = self.schemas.get(channel.schema_id)
+        if schema is None or schema.encoding != "protobuf" or schema.name != expected:
+            found = "none" if schema is None else f"{schema.name!r} ({schema.encoding})"
+            raise LogError(f"{path}: channel {topic}: expected the protobuf schema {expected!r}, found {found}")
+        try:
+            decode = proto.decoder(expected, schema.data)
+        except proto.SchemaProblem as exc:
+            raise LogError(f"{path}: channel {topic}: {exc}") from None
+
+        def checked(data: bytes) -> dict:
+            try:
+                value = decode(data)
+            except (DecodeError, RecursionError, ValueError, UnicodeDecodeError):
+                raise LogError(f"{path}: a message on {topic} is not a valid {expected} message") from None
+            return _checked(path, channel, value)
+
+        return checked
 
 
 def _json_list(text: str, key: str, path: Path) -> list[str]:
@@ -272,6 +328,7 @@ def _overview_from_walk(path: Path, fh: IO[bytes], summary: Summary | None, out:
     found = LogRecords()
     tally = Tally()
     last_status: tuple[int, Channel, bytes] | None = None
+    decode = Decoder(path, found.schemas)
     for channel, message in walk(path, fh, out.complete, {TOPIC_STATUS}, found, tally=tally, stats=stats):
         if last_status is None or message.log_time >= last_status[0]:  # a status message: the only ones decoded
             last_status = (message.log_time, channel, message.data)
@@ -284,7 +341,7 @@ def _overview_from_walk(path: Path, fh: IO[bytes], summary: Summary | None, out:
     if tally.last >= 0:
         out.start_time, out.end_time = tally.first / 1e9, tally.last / 1e9
     if last_status is not None:
-        out.final_status = _decode(path, last_status[1], last_status[2])
+        out.final_status = decode(last_status[1], last_status[2])
     if found.data_crc is not None:
         out.data_checksum = found.data_crc != 0
     out.check, out.chunks, out.chunks_read = "full", len(found.chunks), len(found.chunks)
@@ -314,7 +371,7 @@ def _overview_from_summary(path: Path, fh: IO[bytes], summary: Summary, out: Log
     ids = {cid for cid, channel in summary.channels.items() if channel.topic == TOPIC_STATUS}
     status = last_message(path, fh, summary, ids, counter) if ids else None
     if status is not None:
-        out.final_status = _decode(path, summary.channels[status.channel_id], status.data)
+        out.final_status = Decoder(path, summary.schemas)(summary.channels[status.channel_id], status.data)
     out.check, out.chunks, out.chunks_read = check, len(summary.chunks), counter.chunks - before
     out.summary_checked = True
     if check == "file":
@@ -401,10 +458,13 @@ def iter_messages(path: str | os.PathLike[str], topics: Iterable[str], start: fl
     with open_file(path) as fh:
         complete = ends_with_magic(fh)
         summary = read_summary(path, fh) if complete and window is not None else None
-        for channel, message in walk(path, fh, complete, wanted, window=window, summary=summary, stats=stats):
+        schemas: dict[int, Schema] = {}
+        decode = Decoder(path, schemas)
+        for channel, message in walk(path, fh, complete, wanted, window=window, summary=summary, stats=stats,
+                                     schemas=schemas):
             if stats is not None:
                 stats.messages += 1
-            yield channel.topic, _decode(path, channel, message.data)
+            yield channel.topic, decode(channel, message.data)
 
 
 def check_messages(path: str | os.PathLike[str], topics: Iterable[str]) -> dict[str, int]:
@@ -487,8 +547,9 @@ def read_log(path: str | os.PathLike[str], topics: Iterable[str] | None = None) 
     found = LogRecords()
     with open_file(path) as fh:
         complete = ends_with_magic(fh)
+        decode = Decoder(path, found.schemas)
         for channel, message in walk(path, fh, complete, set(topics) if topics is not None else None, found):
-            messages.setdefault(channel.topic, []).append((message.log_time, _decode(path, channel, message.data)))
+            messages.setdefault(channel.topic, []).append((message.log_time, decode(channel, message.data)))
     out.attachments, out.metadata, out.truncated = found.attachments, found.metadata, not complete
     out.profile = found.header.profile if found.header is not None else ""
     for msgs in messages.values():

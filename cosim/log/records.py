@@ -676,7 +676,7 @@ class LogRecords:
 
 def walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, found: LogRecords | None = None,
          tally: Tally | None = None, window: tuple[int, int] | None = None, summary: Summary | None = None,
-         stats: ReadStats | None = None) -> Iterator[tuple[Channel, Message]]:
+         stats: ReadStats | None = None, schemas: dict[int, Schema] | None = None) -> Iterator[tuple[Channel, Message]]:
     """The messages of a log on ``wanted`` topics (all if None; undecoded) within ``window`` (log times, ns,
     both ends included; None: all), with their channels, in file order: the one walker behind every reader,
     and the one dispatch over the kinds of record.
@@ -687,9 +687,12 @@ def walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, fou
     constant memory). With a ``window`` and the log's ``summary``, only the
     chunks that overlap the window are read (no attachments, metadata or
     data-section checksum: :func:`_indexed_records`); otherwise every record
-    is (:func:`_records`), and ``tally``, if given, counts every message.
+    is (:func:`_records`), and ``tally``, if given, counts every message. ``schemas``, if given, gets every
+    schema record (``found``'s, if given), as channels come with theirs: the messages' decoders need them.
     """
     channels: dict[int, Channel] = found.channels if found is not None else {}
+    if schemas is None and found is not None:
+        schemas = found.schemas
     wanted_ids: set[int] = set()
     ids = None if wanted is None else wanted_ids
     if summary is not None and window is not None:
@@ -710,12 +713,12 @@ def walk(path: Path, fh: IO[bytes], complete: bool, wanted: set[str] | None, fou
                 wanted_ids.add(record.id)
             else:
                 wanted_ids.discard(record.id)
+        elif opcode == Opcode.SCHEMA and schemas is not None:
+            schemas[record.id] = record
         elif found is None:
             continue
         elif opcode == Opcode.CHUNK:
             found.chunks.append(record)
-        elif opcode == Opcode.SCHEMA:
-            found.schemas[record.id] = record
         elif opcode == Opcode.ATTACHMENT:
             found.attachments[record.name] = record.data
         elif opcode == Opcode.METADATA:

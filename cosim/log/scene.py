@@ -33,14 +33,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import orjson
 from scipy.interpolate import CubicSpline
 
 from cosim.core.bridge import BridgeModel, PointLoad
 from cosim.core.sensors import Sensor, sensor_row
 from cosim.core.traffic import vehicle_of
 
-from .fill import CENTIMETRE, INTEGER, FilledTemplate, holes
+from . import proto
 from .schemas import SCENE_FRAME, TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM, WORLD_FRAME
 
 __all__ = ["SCENE_MAX_DURATION", "SCENE_RATE_HZ", "ScenePlan", "SceneWriter", "plan_scene", "scene_sensors",
@@ -259,17 +258,6 @@ def scene_sensors(plan: ScenePlan) -> list[Sensor]:
 # --------------------------------------------------------------------------- encoding
 
 
-def _json(value: Any) -> bytes:
-    return orjson.dumps(value)
-
-
-def _template(value: Any) -> bytes:
-    """``value`` as JSON, for a bytes %-template whose ``"%s"`` strings stand for encoded JSON (numbers filled
-    by :class:`cosim.log.fill.FilledTemplate`, strings) and ``"%r"`` for Python numbers (a rounded float's or an
-    int's repr is the JSON orjson writes for it)."""
-    return _json(value).replace(b"%", b"%%").replace(b'"%%s"', b"%s").replace(b'"%%r"', b"%r")
-
-
 def _vec(x: float, y: float, z: float) -> dict[str, float]:
     return {"x": round(float(x), _DECIMALS) + 0.0, "y": round(float(y), _DECIMALS) + 0.0,
             "z": round(float(z), _DECIMALS) + 0.0}
@@ -285,10 +273,9 @@ def _entity(entity_id: str, t: float, **primitives: Any) -> dict[str, Any]:
             "frame_locked": False, **primitives}
 
 
-_Z = "%s"  # a number filled in at every scene
-_ZERO_STAMP = b'"timestamp":{"sec":0,"nsec":0}'  # an entity's timestamp in its template ...
-_OPEN_STAMP = b'"timestamp":{"sec":%s,"nsec":%s}'  # ... and left open for the scene's time
-_R = "%r"  # a Python number filled in at every scene
+_Z = "%s"  # a number filled in at every scene (a hole of the scene's template, :mod:`cosim.log.proto`)
+_OPEN = {"sec": _Z, "nsec": _Z}  # a timestamp filled in at every scene
+_HEAD = ("timestamp", "frame_id", "id", "lifetime", "frame_locked")  # an entity's fields before its primitives
 
 
 def _body(big: bool) -> tuple[float, float, float]:
@@ -325,10 +312,8 @@ class SceneWriter:
         self._columns = first_column + rows[self._have]
         self._marks = np.array([[s.x, s.y] for s in plan.sensors], dtype=float).reshape(-1, 2)
         self._mark_matrix = self.spline_matrix(self._marks[:, 0])
-        self._surface = self._deck_template()
-        self._sensors_template = self._sensor_template()
         self._scene_fill = self._scene_template()
-        self._vehicle_templates: dict[tuple[bool, int, tuple[int, ...]], bytes] = {}
+        self._vehicle_templates: dict[tuple[bool, int, tuple[int, ...]], proto.FixedTemplate] = {}
 
     # ------------------------------------------------------------- geometry
     def spline_matrix(self, x: np.ndarray) -> np.ndarray:
@@ -354,8 +339,8 @@ class SceneWriter:
         w_r, w_l = m @ right, m @ left
         return w_r + share * (w_l - w_r)
 
-    def _deck_template(self) -> bytes:
-        """The deck entity: a surface, its two edges and a cross-line at each station."""
+    def _deck_entity(self) -> dict[str, Any]:
+        """The deck entity: a surface, its two edges and a cross-line at each station (heights left open)."""
         y_min, y_max = self.plan.deck_y
         xs = [round(float(x), _DECIMALS) for x in self.draw_x]
         surface = [{"x": x, "y": y, "z": _Z} for x in xs for y in (y_min, y_max)]
@@ -365,34 +350,30 @@ class SceneWriter:
                   "points": [{"x": x, "y": y, "z": _Z} for x in xs]} for y in (y_min, y_max)]
         cross = [{"x": round(x, _DECIMALS), "y": y, "z": _Z} for x in self.plan.stations for y in (y_min, y_max)]
         lines.append({"type": 2, "thickness": 1.5, "scale_invariant": True, "color": _DARK, "points": cross})
-        entity = _entity("deck", 0.0, triangles=[{"points": surface, "color": _GREY, "indices": triangles}],
-                         lines=lines)
-        return _template(entity)
+        return {**_entity("deck", 0.0, triangles=[{"points": surface, "color": _GREY, "indices": triangles}],
+                          lines=lines), "timestamp": _OPEN}
 
-    def _path_template(self) -> bytes:
+    def _path_entity(self) -> dict[str, Any]:
         """The wheel paths on the deck: a line per path, following the deck."""
         lines = [{"type": 0, "thickness": 3.0, "scale_invariant": True, "color": _PATH,
                   "points": [{"x": round(float(x), _DECIMALS), "y": y, "z": _Z} for x in self.draw_x]}
                  for y in self.paths]
-        return _template(_entity("wheel paths", 0.0, lines=lines))
+        return {**_entity("wheel paths", 0.0, lines=lines), "timestamp": _OPEN}
 
-    def _sensor_template(self) -> bytes:
+    def _sensor_entity(self) -> dict[str, Any]:
         spheres = [{"pose": {"position": {"x": s.x, "y": s.y, "z": _Z}, "orientation": _IDENTITY},
                     "size": {"x": 0.6, "y": 0.6, "z": 0.6}, "color": _QUANTITY_COLORS[s.quantity]}
                    for s in self.plan.sensors]
-        return _template(_entity("sensors", 0.0, spheres=spheres))
+        return {**_entity("sensors", 0.0, spheres=spheres), "timestamp": _OPEN}
 
-    def _scene_template(self) -> FilledTemplate:
+    def _scene_template(self) -> proto.FixedTemplate:
         """A scene up to its vehicles: the deck, the wheel paths and the sensors, with their timestamps and
-        drawn heights left open (filled in :meth:`_write`)."""
-        parts = [self._surface, *([self._path_template()] if self.paths else []),
-                 *([self._sensors_template] if self.plan.sensors else [])]
-        entities = [p.replace(_ZERO_STAMP, _OPEN_STAMP, 1) for p in parts]
-        template = b'{"deletions":[{' + _OPEN_STAMP + b',"type":1,"id":""}],"entities":[' + b",".join(entities)
-        kinds = [INTEGER, INTEGER]
-        for p in parts:
-            kinds += [INTEGER, INTEGER] + [CENTIMETRE] * holes(p)
-        return FilledTemplate(template, kinds)
+        drawn heights left open (filled in :meth:`_write`, the heights to the centimetre)."""
+        entities = [self._deck_entity(), *([self._path_entity()] if self.paths else []),
+                    *([self._sensor_entity()] if self.plan.sensors else [])]
+        scene = {"deletions": [{"timestamp": _OPEN, "type": 1, "id": ""}], "entities": entities}
+        value, _ = proto.number_holes(scene, _Z)
+        return proto.FixedTemplate(self.rec.spec(TOPIC_SCENE), value, decimals=_DECIMALS)
 
     # ------------------------------------------------------------- messages
     def start(self) -> None:
@@ -497,33 +478,34 @@ class SceneWriter:
                 groups.setdefault(vehicle_of(contact), []).append(j)
             heavy = {owner: len(cols) > 1 or max(report.models[j].total_mass for j in cols) > HEAVY_KG
                      for owner, cols in groups.items()}
-        datas: list[bytes] = []
-        stamp_of = list(zip(seconds.tolist(), nanoseconds.tolist()))
-        for i, k in enumerate(rows):
-            cars = self._vehicles(stamp_of[i], report, k, groups, heavy, x[i], near[i], z[i]) \
-                if vehicles else []
-            datas.append(b",".join([scenes[i], *cars]) + b"]}")
-        self.rec.write_encoded(TOPIC_SCENE, times, datas)
+        if vehicles:
+            stamp_of = list(zip(seconds.tolist(), nanoseconds.tolist()))
+            scenes = [b"".join([scene, *self._vehicles(stamp_of[i], report, k, groups, heavy, x[i], near[i], z[i])])
+                      for i, (k, scene) in enumerate(zip(rows, scenes))]
+        self.rec.write_encoded(TOPIC_SCENE, times, scenes)
 
-    def _vehicle_template(self, big: bool, axles: int, arrows: tuple[int, ...]) -> bytes:
-        """A vehicle's entity with its numbers left open (``arrows``: per axle 0 none, 1 push, -1 pull), made
-        once per shape: building and encoding the nested dicts at every scene was most of the scene's cost."""
+    def _vehicle_template(self, big: bool, axles: int, arrows: tuple[int, ...]) -> proto.FixedTemplate:
+        """A vehicle's entity but its id, its numbers left open (``arrows``: per axle 0 none, 1 push, -1 pull),
+        made once per shape: building and encoding the nested messages at every scene was most of its cost."""
         key = (big, axles, arrows)
         template = self._vehicle_templates.get(key)
         if template is None:
             width, height, wheel = _body(big)
-            point = {"x": _R, "y": _R, "z": _R}
+            point = {"x": _Z, "y": _Z, "z": _Z}
             box = {"pose": {"position": point, "orientation": _IDENTITY},
-                   "size": {"x": _R, "y": _c(width), "z": _c(height)}, "color": _TRUCK if big else _CAR}
+                   "size": {"x": _Z, "y": _c(width), "z": _c(height)}, "color": _TRUCK if big else _CAR}
+            # A wheel: the cylinder's scales written out (protobuf's default, 0, would draw a cone to a point).
             cylinders = [{"pose": {"position": point, "orientation": _AXLE_ALONG_Y},
-                          "size": _vec(wheel, wheel, width + 0.2), "color": _WHEEL} for _ in range(axles)]
+                          "size": _vec(wheel, wheel, width + 0.2), "bottom_scale": 1.0, "top_scale": 1.0,
+                          "color": _WHEEL} for _ in range(axles)]
             drawn = [{"pose": {"position": point, "orientation": _ARROW_DOWN if sign > 0 else _ARROW_UP},
-                      "shaft_length": _R, "shaft_diameter": 0.2, "head_length": _R, "head_diameter": 0.5,
+                      "shaft_length": _Z, "shaft_diameter": 0.2, "head_length": _Z, "head_diameter": 0.5,
                       "color": _PUSH if sign > 0 else _PULL} for sign in arrows if sign]
-            entity = {"timestamp": {"sec": _R, "nsec": _R}, "frame_id": SCENE_FRAME, "id": _Z,
-                      "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": False, "cubes": [box],
-                      "cylinders": cylinders, "arrows": drawn}
-            template = self._vehicle_templates[key] = _template(entity)
+            entity = {"timestamp": _OPEN, "frame_id": SCENE_FRAME, "lifetime": {"sec": 0, "nsec": 0},
+                      "frame_locked": False, "cubes": [box], "cylinders": cylinders, "arrows": drawn}
+            value, _ = proto.number_holes(entity, _Z)
+            template = self._vehicle_templates[key] = proto.FixedTemplate(self.rec.spec(TOPIC_SCENE).fields[1].message,
+                                                                          value)
         return template
 
     def _vehicles(self, stamp: tuple[int, int], report: Any, k: int, groups: dict[str, list[int]],
@@ -549,8 +531,8 @@ class SceneWriter:
             front, back = max(xs) + overhang, min(xs) - overhang
             y = sum(float(y_all[j]) for j in cols) / len(cols)
             z0 = sum(zs) / len(cols)
-            numbers: list[Any] = [sec, nsec, orjson.dumps(f"vehicle {owner}"),
-                                  _c((front + back) / 2), _c(y), _c(z0 + wheel * 0.6 + height / 2), _c(front - back)]
+            numbers: list[Any] = [sec, nsec, _c((front + back) / 2), _c(y), _c(z0 + wheel * 0.6 + height / 2),
+                                  _c(front - back)]
             for x, z in zip(xs, zs):
                 numbers += (_c(x), _c(y), _c(z + wheel / 2))
             arrows = []
@@ -565,5 +547,6 @@ class SceneWriter:
                 # Beside the body (on its right), where the box does not hide it, down to the deck.
                 numbers += (_c(x), _c(y - width / 2 - 0.4), _c(z + (length if force > 0 else 0.0)),
                             round(length - head, _DECIMALS), round(head, _DECIMALS))
-            out.append(self._vehicle_template(big, len(cols), tuple(arrows)) % tuple(numbers))
+            body = self._vehicle_template(big, len(cols), tuple(arrows)).row(numbers)
+            out.append(proto.length_delimited(2, body + proto.length_delimited(3, f"vehicle {owner}".encode())))
         return out

@@ -16,7 +16,6 @@ from __future__ import annotations
 import bisect
 import dataclasses
 import itertools
-import json
 import queue
 import struct
 import threading
@@ -27,7 +26,6 @@ from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-import orjson
 from mcap.opcode import Opcode
 from mcap.records import MessageIndex, Statistics
 from mcap.writer import CompressionType, Writer
@@ -36,8 +34,9 @@ from cosim import __version__
 from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
 from cosim.core.traffic import vehicle_of
 from cosim.core.vehicles import model_to_dict
-from cosim.errors import LogError, interruption_message
+from cosim.errors import LogError, LogWriteError, interruption_message
 
+from . import proto
 from .schemas import (
     PROFILE,
     TOPIC_EVENTS,
@@ -54,7 +53,6 @@ from .schemas import (
 _MESSAGE_HEAD = struct.Struct("<BQHIQQ")  # opcode, record length, channel id, sequence, log time, publish time
 _MESSAGE_OPCODE = 0x05
 _MESSAGE_FIXED = 22  # channel id (2) + sequence (4) + log time (8) + publish time (8)
-_NUMPY = orjson.OPT_SERIALIZE_NUMPY
 
 
 class _MessageIndex(MessageIndex):
@@ -166,17 +164,6 @@ class _BulkWriter(Writer):
         return sequence
 
 
-def _template_part(value: str) -> bytes:
-    """A JSON string for a bytes %-template (``%`` doubled)."""
-    return orjson.dumps(value).replace(b"%", b"%%")
-
-
-def _number_tokens(values: np.ndarray) -> list[bytes]:
-    """The JSON numbers of a 2-D float array, row by row (one orjson call: shortest round-trip form)."""
-    text = orjson.dumps(np.ascontiguousarray(values, dtype=np.float64), option=_NUMPY)
-    return text.replace(b"[", b"").replace(b"]", b"").split(b",")
-
-
 class LogRecorder:
     """Write one run's MCAP log; use as a context manager.
 
@@ -207,12 +194,16 @@ class LogRecorder:
         self._sequence = 0
         self._closed = False
         self.final_state: str | None = None
-        schema_ids: dict[bytes, int] = {}
-        for topic, schema in topic_schemas(self.sensor_names, scene=scene):
-            text = json.dumps(schema).encode()
-            if text not in schema_ids:  # one schema record for the topics that share it
-                schema_ids[text] = self._writer.register_schema(schema["title"], "jsonschema", text)
-            self._channels[topic] = self._writer.register_channel(topic, "json", schema_ids[text])
+        schema_ids: dict[str, int] = {}
+        names = tuple(self.sensor_names)
+        self._specs: dict[str, proto.MessageSpec] = {}
+        for topic, _ in topic_schemas(self.sensor_names, scene=scene):
+            message = proto.TOPIC_MESSAGES[topic]
+            if message not in schema_ids:  # one schema record for the topics that share it
+                data = proto.schema_data(message, names)
+                schema_ids[message] = self._writer.register_schema(message, proto.SCHEMA_ENCODING, data)
+            self._channels[topic] = self._writer.register_channel(topic, proto.ENCODING, schema_ids[message])
+            self._specs[topic] = proto.spec_of(message, names if topic == TOPIC_SENSORS else ())
         self._last_t = 0.0
         # The block logger's thread and the traffic source (main thread) both write.
         self._lock = threading.Lock()
@@ -229,18 +220,23 @@ class LogRecorder:
         with self._lock:
             self._writer.add_metadata(name, {k: str(v) for k, v in values.items()})
 
+    def spec(self, topic: str) -> proto.MessageSpec:
+        """What the messages of ``topic`` are made of (:mod:`cosim.log.proto`)."""
+        return self._specs[topic]
+
     def write(self, topic: str, t: float, message: dict[str, Any]) -> None:
-        """One JSON message on ``topic`` at simulated time ``t`` (s)."""
+        """One message on ``topic`` at simulated time ``t`` (s), given as the JSON log held it."""
         ns = to_ns(t)
-        # orjson: the logging budget is a fraction of a ~20 us solver step per sample.
-        data = orjson.dumps(message)
+        if topic == TOPIC_VEHICLE_TYPES:
+            message = proto.vehicle_type_wire(message)
+        data = proto.encode(self._specs[topic], message)
         with self._lock:
             self._sequence += 1
             self._writer.add_message(self._channels[topic], ns, data, ns, self._sequence)
             self._last_t = max(self._last_t, t)
 
     def write_encoded(self, topic: str, times: list[float], datas: list[bytes]) -> None:
-        """Many messages on ``topic``, already JSON-encoded, at simulated times ``times`` (s)."""
+        """Many messages on ``topic``, already encoded, at simulated times ``times`` (s)."""
         if not datas:
             return
         log_times = np.rint(np.asarray(times, dtype=np.float64) * 1e9).astype(np.int64).tolist()  # = to_ns
@@ -369,8 +365,9 @@ class BlockLogger:
         self._last_x: dict[str, float] = {}  # vehicles on the deck at the end of the last block: their x
         self._model_names: dict[str, str] = {}  # the last block's vehicles' models' names
         self._names_of: tuple[str, ...] = ()
-        self._sensor_template = (b'{"t":%s' + b"".join(b"," + _template_part(n) + b":%s" for n in self.names) + b"}")
-        self._vehicle_templates: dict[tuple[str, ...], bytes] = {}
+        holes = {"t": proto.Hole(0), **{n: proto.Hole(i + 1) for i, n in enumerate(self.names)}}
+        self._sensor_template = proto.FixedTemplate(recorder.spec(TOPIC_SENSORS), holes)
+        self._vehicle_templates: dict[tuple[str, ...], proto.FixedTemplate] = {}
         self._error: BaseException | None = None
         self._pace: threading.Event | None = None
         self._closing = False
@@ -399,7 +396,7 @@ class BlockLogger:
 
     def on_block(self, times, keep, report) -> None:
         if self._error is not None:
-            raise LogError(f"{self.rec.path}: writing the log failed: {self._error}")
+            raise LogWriteError(f"{self.rec.path}: writing the log failed: {self._error}")
         frames = self._frames[:]
         self._frames.clear()  # the same list: the traffic sink appends to it
         if self._queue is None:
@@ -468,7 +465,7 @@ class BlockLogger:
             self._thread = None
         if self._error is not None:
             where = getattr(self, "_error_trace", "").strip().splitlines()
-            raise LogError(f"{self.rec.path}: writing the log failed: {self._error!r}"
+            raise LogWriteError(f"{self.rec.path}: writing the log failed: {self._error!r}"
                            + (f" ({where[-3].strip()})" if len(where) >= 3 else ""))
 
     def __enter__(self) -> BlockLogger:
@@ -511,11 +508,8 @@ class BlockLogger:
         kept = np.flatnonzero(keep)
         if len(kept):
             t = times[kept]
-            width = 1 + len(self.names)
-            tokens = _number_tokens(np.column_stack([t, report.sensors[kept, :width - 1]]))
-            template = self._sensor_template
-            rec.write_encoded(TOPIC_SENSORS, t.tolist(),
-                              [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)])
+            values = np.column_stack([t, report.sensors[kept, :len(self.names)]])
+            rec.write_encoded(TOPIC_SENSORS, t.tolist(), self._sensor_template.render(values))
         self._gone(times, report)
         if report.ids:
             self._events(times, report)
@@ -589,22 +583,22 @@ class BlockLogger:
                 self._lifted.pop(vid, None)
                 self._last_x.pop(vid, None)
 
-    def _vehicle_item(self, vid: str) -> bytes:
-        """``{"id":..,"model":..,"x":%s,...}``: one vehicle's item, its fields in :data:`VEHICLE_FIELDS` order."""
-        text = {"id": vid, "model": self._model_names[vid]}
-        parts = [_template_part(f.name) + b":" + (_template_part(text[f.name]) if f.json_type == "string" else b"%s")
-                 for f in VEHICLE_FIELDS]
-        return b"{" + b",".join(parts) + b"}"
-
-    def _vehicle_template(self, ids: tuple[str, ...]) -> bytes:
-        """``{"t":%s,"vehicles":[{"id":..,"model":..,"x":%s,...},...]}`` for these vehicles, in this order."""
-        key = ids
-        template = self._vehicle_templates.get(key)
+    def _vehicle_template(self, ids: tuple[str, ...]) -> proto.FixedTemplate:
+        """The message of these vehicles on the deck, in this order, with holes for ``t`` and their numbers
+        (:data:`VEHICLE_FIELDS` order), made once per fleet."""
+        template = self._vehicle_templates.get(ids)
         if template is None:
-            template = b'{"t":%s,"vehicles":[' + b",".join(self._vehicle_item(vid) for vid in ids) + b"]}"
+            holes = iter(range(1 + len(VEHICLE_NUMBERS) * len(ids)))
+            text = {}
+            vehicles = []
+            for vid in ids:
+                text = {"id": vid, "model": self._model_names[vid]}
+                vehicles.append({f.name: text[f.name] if f.json_type == "string" else proto.Hole(next(holes) + 1)
+                                 for f in VEHICLE_FIELDS})
+            template = proto.FixedTemplate(self.rec.spec(TOPIC_VEHICLES), {"t": proto.Hole(0), "vehicles": vehicles})
             if len(self._vehicle_templates) > 256:
                 self._vehicle_templates.clear()
-            self._vehicle_templates[key] = template
+            self._vehicle_templates[ids] = template
         return template
 
     def _vehicles(self, times, kept, report) -> None:
@@ -637,8 +631,7 @@ class BlockLogger:
             template = self._vehicle_template(tuple(ids[j] for j in cols))
             width = 1 + width_per_vehicle * len(cols)
             values = np.column_stack([t[lo:hi], fields[lo:hi][:, cols, :].reshape(hi - lo, width - 1)])
-            tokens = _number_tokens(values)
-            out[lo:hi] = [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)]
+            out[lo:hi] = template.render(values)
         self.rec.write_encoded(TOPIC_VEHICLES, t.tolist(), out)
 
 
@@ -655,6 +648,7 @@ class TrafficLogger:
         self._types: set[str] = set()  # the types whose message is written
         self._models: dict[str, Any] = {}  # every type announced by the source (its model)
         self._defer = defer  # frames are appended here for a writer thread (BlockLogger.traffic_sink)
+        self._strings: dict[tuple[int, str], bytes] = {}  # (field, id or type) -> its encoded field
 
     def attach(self, name: str, data: bytes | str, media_type: str = "text/plain") -> None:
         """A document of the traffic source (its vehicle types, SUMO's messages) as an attachment of the log."""
@@ -695,8 +689,26 @@ class TrafficLogger:
                 self.rec.write(TOPIC_VEHICLE_TYPES, frame.t, {"t": frame.t, "type": typ,
                                                               "model": model_to_dict(self._models[typ])})
 
-    @staticmethod
-    def _encode(frame) -> bytes:
-        return orjson.dumps({
-            "t": frame.t, "ids": list(frame.ids), "x": frame.x.tolist(), "y": frame.y.tolist(),
-            "speed": frame.v.tolist(), "acceleration": frame.a.tolist(), "types": list(frame.types)})
+    def _encode(self, frame) -> bytes:  # noqa: ANN001
+        """A frame as its ``cosim.TrafficFrame`` (the strings' fields encoded once per id and type)."""
+        strings = self._strings
+        parts = [_T_FIELD, _DOUBLE.pack(frame.t)]
+        for number, values in ((2, frame.ids), (7, frame.types)):
+            for value in values:
+                field = strings.get((number, value))
+                if field is None:
+                    if len(strings) > 100_000:
+                        strings.clear()
+                    field = strings[(number, value)] = proto.length_delimited(number, value.encode())
+                parts.append(field)
+        count = len(frame.ids)
+        if count:
+            head = _PACKED_LENGTH.get(count) or proto.varint(8 * count)
+            for tag, values in ((b"\x1a", frame.x), (b"\x22", frame.y), (b"\x2a", frame.v), (b"\x32", frame.a)):
+                parts += (tag, head, np.ascontiguousarray(values, dtype="<f8").tobytes())
+        return b"".join(parts)
+
+
+_T_FIELD = b"\x09"  # field 1 (t), a double
+_DOUBLE = struct.Struct("<d")
+_PACKED_LENGTH = {n: proto.varint(8 * n) for n in range(1, 16)}  # the length of n packed doubles

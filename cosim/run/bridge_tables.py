@@ -291,11 +291,17 @@ class SectionConfig(ConfigModel):
     def build(self, nu: float) -> SectionProperties:
         """Section constants: from the plates (FE section solver) or the given constants.
 
+        A plate section solved once is read back from the user's cache folder afterwards
+        (:mod:`cosim.run.section_cache`).
+
         Args:
             nu: Poisson's ratio of the material (the FE solver's shear areas depend on it).
         """
         if self.plates is not None:
-            return section_from_plates([p.to_plate() for p in self.plates], nu=nu, mesh_size=self.mesh_size)
+            from .section_cache import user_section_cache
+
+            return section_from_plates([p.to_plate() for p in self.plates], nu=nu, mesh_size=self.mesh_size,
+                                       store=user_section_cache())
         assert self.constants is not None
         c = self.constants
         keys = ("y_s", "z_s", "A_sy", "A_sz", "I_ws", "mass_per_length")

@@ -38,7 +38,16 @@ from cosim.core.sensors import Sensor
 from cosim.core.simulation import SimulationResult, SolverSettings, simulate
 from cosim.core.traffic import AXLE_SEPARATOR, Frame, FrameSink, ScriptedTraffic, TrafficSource
 from cosim.core.vehicles import VehicleModel
-from cosim.errors import ConfigError, CosimError, Interrupted, LogError, ModelError, interruption, interruption_message
+from cosim.errors import (
+    ConfigError,
+    CosimError,
+    Interrupted,
+    LogError,
+    LogWriteError,
+    ModelError,
+    interruption,
+    interruption_message,
+)
 from cosim.log.layout import inputs_from_metadata, layout_bytes, make_layout
 from cosim.log.process import LogProcess, fork_possible
 from cosim.log.scene import ScenePlan, plan_scene, scene_sensors, scene_wanted
@@ -85,6 +94,38 @@ class RunFailed(ModelError):
     def __init__(self, message: str, log_path: Path) -> None:
         super().__init__(message)
         self.log_path = log_path
+
+
+class LogCutShort(RunFailed):
+    """Writing the log failed during the run (a full disk, a file-size limit): the file is cut short, without a
+    final status; it can be read up to ``readable_until``.
+
+    Attributes:
+        log_path: the log, as far as it was written.
+        readable_until: the simulated time of its last readable message, s; None when nothing of it can be read.
+    """
+
+    def __init__(self, message: str, log_path: Path, readable_until: float | None) -> None:
+        super().__init__(message, log_path)
+        self.readable_until = readable_until
+
+
+def _cut_short(exc: LogWriteError, log_path: Path, partial: Path, duration: float) -> LogCutShort:
+    """What a run whose log could not be written says: the error, and up to which simulated time the file can
+    be read (read back from the file itself, as any reader would)."""
+    from cosim.log import open_log
+
+    text = str(exc).replace(str(partial), str(log_path))
+    try:
+        overview = open_log(log_path)
+        until: float | None = overview.end_time if sum(overview.counts.values()) else None
+    except (LogError, OSError):
+        until = None
+    if until is None:
+        where = "nothing of it can be read"
+    else:
+        where = f"it can be read up to t = {until:g} s of the {duration:g} s simulated (and has no final status)"
+    return LogCutShort(f"{text}; the log {log_path} is cut short: {where}", log_path, until)
 
 
 @dataclass
@@ -329,6 +370,7 @@ def _metadata(scenario: Scenario, plan_scene_: ScenePlan | None, solver: SolverS
     contacts = _contact_ids(traffic)
     return {
         "version": __version__,
+        "encoding": "protobuf",  # the messages' (cosim.log.proto); logs without this key are JSON
         "kind": "replay" if replay else "run",
         "scenario": scenario.title,
         "source": scenario.source,
@@ -617,6 +659,11 @@ def _stream(run: RunPlan, guard: StopGuard, traffic: TrafficSource, relay: Frame
             if isinstance(exc, CosimError):
                 raise
             raise ModelError(f"{scenario.source}: {exc}") from None
+        if isinstance(exc, LogWriteError):
+            sumo_said()
+            with contextlib.suppress(Exception):
+                rec.close("error", str(exc))  # whatever still can be written; the first error is the one said
+            raise _cut_short(exc, log_path, partial, duration) from None
         if isinstance(exc, CosimError) and not isinstance(exc, ModelError):
             message = str(exc)
         else:
@@ -643,7 +690,10 @@ def _stream(run: RunPlan, guard: StopGuard, traffic: TrafficSource, relay: Frame
         rec.metadata(FATIGUE_METADATA_NAME, {k: json.dumps(jsonable(v)) for k, v in payload.items()})
     sumo_said()
     wall = time.perf_counter() - wall_start
-    rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
+    try:
+        rec.close("finished", f"{duration:g} s simulated in {wall:.3g} s", wall_time=wall)
+    except LogWriteError as exc:
+        raise _cut_short(exc, log_path, partial, duration) from None
     if plan is not None:
         result = _named_only(result, names)
     return RunOutcome(

@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from _cli import TWO_CARS, cosim_cli
 
-from cosim.log import open_log, read_log
+from cosim.log import open_log, read_log, sensor_series
 from cosim.log.schemas import (
     LAYOUT_ATTACHMENT,
     TOPIC_SCENE,
@@ -93,10 +93,34 @@ def picked(messages: dict[str, list[tuple[int, dict]]], path: str) -> list[Any]:
     return values
 
 
+def as_foxglove_reads(log: Path) -> dict[str, list[tuple[int, Any]]]:
+    """Every message of ``log`` as Foxglove reads it: decoded with the schema stored in the file (protobuf: by
+    the protobuf runtime, its fields by their names, zeros included; JSON: as it is), by topic."""
+    from google.protobuf import descriptor_pb2, json_format, message_factory
+    from mcap.reader import make_reader
+
+    out: dict[str, list[tuple[int, Any]]] = {}
+    classes: dict[tuple[str, bytes], Any] = {}
+    with open(log, "rb") as fh:
+        for schema, channel, message in make_reader(fh).iter_messages():
+            if channel.message_encoding == "json":
+                value = json.loads(message.data)
+            else:
+                key = (schema.name, schema.data)
+                if key not in classes:
+                    files = list(descriptor_pb2.FileDescriptorSet.FromString(schema.data).file)
+                    classes[key] = message_factory.GetMessages(files)[schema.name]
+                value = json_format.MessageToDict(classes[key].FromString(message.data),
+                                                  preserving_proto_field_name=True,
+                                                  always_print_fields_with_no_presence=True)
+            out.setdefault(channel.topic, []).append((message.log_time, value))
+    return out
+
+
 def check_layout(layout: dict[str, Any], log: Path) -> list[str]:
-    """Every panel of ``layout`` shows something of ``log``: each plot series picks numbers, each table and
-    raw-message panel has messages, the 3D panel's topics exist; returns the panels' ids."""
-    messages = read_log(log).messages
+    """Every panel of ``layout`` shows something of ``log`` as Foxglove reads it: each plot series picks numbers,
+    each table and raw-message panel has messages, the 3D panel's topics exist; returns the panels' ids."""
+    messages = as_foxglove_reads(log)
     config = layout["configById"]
     for panel, settings in config.items():
         if panel.startswith("Plot!"):
@@ -179,7 +203,8 @@ def test_logs_written_before_layouts_get_one(name: str, tmp_path: Path) -> None:
 
 def test_a_sumo_run_draws_its_traffic_in_the_scene(tmp_path: Path) -> None:
     """Real SUMO (the bundled light demand): the vehicles appear in the scene, the lanes are learnt from the
-    traffic, and a sensor whose name has a dot is quoted in its plot path."""
+    traffic, and a sensor whose name has a dot is plotted by its field (a protobuf identifier: ``mid_left``,
+    whose json_name is the sensor's name; older JSON logs quote it, below)."""
     sumo = tmp_path / "sumo"
     sumo.mkdir()
     for name in ("light.sumocfg", "bridge.net.xml", "vtypes.add.xml", "light.rou.xml"):
@@ -192,7 +217,9 @@ def test_a_sumo_run_draws_its_traffic_in_the_scene(tmp_path: Path) -> None:
     layout = json.loads((tmp_path / "layout.json").read_text())
     check_layout(layout, log)
     paths = [p["value"] for p in layout["configById"]["Plot!acceleration"]["paths"]]
-    assert paths == [f'{TOPIC_SENSORS}."mid.left"']
+    assert paths == [f"{TOPIC_SENSORS}.mid_left"]
+    assert [p["label"] for p in layout["configById"]["Plot!acceleration"]["paths"]] == ["mid.left"]
+    assert sensor_series(log, ["mid.left"])[1]["mid.left"].size == 2801  # cosim reads it by the sensor's name
     contents = read_log(log, topics=[TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM, TOPIC_VEHICLES])
     scenes = contents.topic(TOPIC_SCENE)
     assert len(scenes) == 701  # 10 Hz over 70 s, and t = 0

@@ -22,9 +22,11 @@ MAGIC = b"\x89MCAP0\r\n"
 def rewrite(source: Path, target: Path, *, attachments: dict[str, bytes | None] | None = None,
             metadata: dict[str, dict[str, str]] | None = None,
             message: Callable[[str, dict[str, Any]], dict[str, Any] | None] | None = None,
+            raw: Callable[[Any, str, bytes], bytes | None] | None = None,
             profile: str = "cosim") -> Path:
     """``source`` written again as ``target``: attachments replaced (None: dropped) or added, metadata
-    records updated key by key, and each message passed through ``message(topic, decoded)`` (None: dropped)."""
+    records updated key by key, and each message passed through ``message(topic, decoded)`` (JSON logs: the
+    message's JSON) or ``raw(schema, topic, data)`` (its bytes, any encoding; None: dropped)."""
     attachments = dict(attachments or {})
     metadata = metadata or {}
     with open(source, "rb") as fh:
@@ -48,6 +50,11 @@ def rewrite(source: Path, target: Path, *, attachments: dict[str, bytes | None] 
             writer.add_metadata(meta.name, {**meta.metadata, **metadata.get(meta.name, {})})
         for _schema, channel, msg in reader.iter_messages():
             data = msg.data
+            if raw is not None:
+                changed = raw(_schema, channel.topic, data)
+                if changed is None:
+                    continue
+                data = changed
             if message is not None:
                 value = message(channel.topic, json.loads(data))
                 if value is None:
@@ -121,3 +128,15 @@ def records(path: Path) -> list[tuple[int, int, int]]:
             break
         position += 9 + length
     return found
+
+
+def edit_protobuf(schema: Any, data: bytes, change: Callable[[Any], None]) -> bytes:
+    """A protobuf message changed field by field: parsed with the protobuf runtime from the log's own schema
+    record (its ``FileDescriptorSet``), ``change(message)`` applied, serialized again (a valid message whose
+    values lie)."""
+    from google.protobuf import descriptor_pb2, message_factory
+
+    files = descriptor_pb2.FileDescriptorSet.FromString(schema.data).file
+    message = message_factory.GetMessages(list(files))[schema.name].FromString(data)
+    change(message)
+    return message.SerializeToString()

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
-from _craft import rewrite
+from _craft import edit_protobuf, rewrite
 from _robust import PROFILED, ROAD_CSV, SUMO_SCENARIO, assert_one_line, cosim_cli, sumo_folder, write
 
 from cosim.log import TOPIC_SENSORS, TOPIC_TRAFFIC, TOPIC_VEHICLES, open_log
@@ -76,22 +76,67 @@ def _spoil(topic_wanted: str, change):  # noqa: ANN001, ANN202
     return message
 
 
-def test_crafted_message_contents_are_one_line_for_every_reader(profiled_log: Path, sumo_log: Path,
-                                                                 tmp_path: Path) -> None:
-    sensors = rewrite(profiled_log, tmp_path / "sensors.mcap",
-                      message=_spoil(TOPIC_SENSORS, lambda m: {**m, "mid": "0.001"}))
+#: Logs written by earlier versions, in JSON (tests/regression/logs): crafted JSON messages are crafted from them.
+OLD_LOGS = Path(__file__).resolve().parents[1] / "regression" / "logs"
+
+
+def test_crafted_json_messages_are_one_line_for_every_reader(tmp_path: Path) -> None:
+    """Logs of earlier versions are JSON: a message that parses but lies is one line, for every reader."""
+    scripted, sumo = OLD_LOGS / "paper-double-tee.mcap", OLD_LOGS / "paper-bridge-traffic-fixed-weights.mcap"
+    sensors = rewrite(scripted, tmp_path / "sensors.mcap",
+                      message=_spoil(TOPIC_SENSORS, lambda m: {**m, "node1": "0.001"}))
     for args in (("export", str(sensors), "--csv", "o.csv"), ("plot", str(sensors), "-o", "o.png"),
                  ("replay", str(sensors), "--out", "r.mcap")):
         assert_one_line(cosim_cli(*args, cwd=tmp_path), 2, "a message on /cosim/sensors", "does not match its schema",
-                        "mid: expected a finite number, got '0.001'")
-    vehicles = rewrite(profiled_log, tmp_path / "vehicles.mcap",
+                        "node1: expected a finite number, got '0.001'")
+    vehicles = rewrite(scripted, tmp_path / "vehicles.mcap",
                        message=_spoil(TOPIC_VEHICLES, lambda m: {**m, "vehicles": 5}))
     assert_one_line(cosim_cli("export", str(vehicles), "--topic", TOPIC_VEHICLES, "--csv", "v.csv", cwd=tmp_path), 2,
                     "vehicles: expected an array, got 5")
-    frames = rewrite(sumo_log, tmp_path / "frames.mcap", message=_spoil(TOPIC_TRAFFIC, lambda m: {**m, "x": ["a"]}))
+    frames = rewrite(sumo, tmp_path / "frames.mcap", message=_spoil(TOPIC_TRAFFIC, lambda m: {**m, "x": ["a"]}))
     assert_one_line(cosim_cli("replay", str(frames), "--out", "r.mcap", cwd=tmp_path), 2, "a message on /cosim/traffic",
                     "x[0]: expected a finite number")
-    short = rewrite(sumo_log, tmp_path / "short.mcap", message=_spoil(TOPIC_TRAFFIC, lambda m: {**m, "x": []}))
+    garbage = rewrite(scripted, tmp_path / "garbage.mcap",
+                      raw=lambda _s, topic, data: data[:-3] if topic == TOPIC_SENSORS else data)
+    assert_one_line(cosim_cli("export", str(garbage), "--csv", "o.csv", cwd=tmp_path), 2,
+                    "a message on /cosim/sensors is not valid JSON")
+    assert not any((tmp_path / n).exists() for n in ("o.csv", "o.png", "r.mcap", "v.csv", "runs"))
+
+
+def _spoil_bytes(topic_wanted: str, change):  # noqa: ANN001, ANN202
+    """The fifth message of a topic through ``change(schema, data)``, the others as they are."""
+    seen = {"n": 0}
+
+    def raw(schema, topic: str, data: bytes) -> bytes:  # noqa: ANN001
+        if topic == topic_wanted:
+            seen["n"] += 1
+            if seen["n"] == 5:
+                return change(schema, data)
+        return data
+
+    return raw
+
+
+def test_crafted_protobuf_messages_are_one_line_for_every_reader(profiled_log: Path, sumo_log: Path,
+                                                                  tmp_path: Path) -> None:
+    """Logs of this version are protobuf: bytes that do not parse, and a valid message whose values lie (crafted
+    with the protobuf runtime from the log's own schema), are each one line, for every reader."""
+    cut = rewrite(profiled_log, tmp_path / "cut.mcap", raw=_spoil_bytes(TOPIC_SENSORS, lambda _s, d: d[: len(d) // 2]))
+    for args in (("export", str(cut), "--csv", "o.csv"), ("plot", str(cut), "-o", "o.png"),
+                 ("replay", str(cut), "--out", "r.mcap")):
+        assert_one_line(cosim_cli(*args, cwd=tmp_path), 2, "a message on /cosim/sensors",
+                        "is not a valid cosim.SensorSample message")
+    nan = rewrite(profiled_log, tmp_path / "nan.mcap", raw=_spoil_bytes(
+        TOPIC_SENSORS, lambda s, d: edit_protobuf(s, d, lambda m: setattr(m, "mid", float("nan")))))
+    for args in (("export", str(nan), "--csv", "o.csv"), ("plot", str(nan), "-o", "o.png")):
+        assert_one_line(cosim_cli(*args, cwd=tmp_path), 2, "a message on /cosim/sensors", "does not match its schema",
+                        "mid: expected a finite number, got nan")
+    garbage = rewrite(profiled_log, tmp_path / "garbage.mcap",
+                      raw=_spoil_bytes(TOPIC_VEHICLES, lambda _s, _d: b"\xff\xff\xff\xff"))
+    assert_one_line(cosim_cli("export", str(garbage), "--topic", TOPIC_VEHICLES, "--csv", "v.csv", cwd=tmp_path), 2,
+                    "a message on /cosim/vehicles is not a valid cosim.VehiclesOnDeck message")
+    short = rewrite(sumo_log, tmp_path / "short.mcap", raw=_spoil_bytes(
+        TOPIC_TRAFFIC, lambda s, d: edit_protobuf(s, d, lambda m: m.ClearField("x"))))
     assert_one_line(cosim_cli("replay", str(short), "--out", "r.mcap", "--quiet", cwd=tmp_path), 2, "ids but 0 x")
     meta = rewrite(profiled_log, tmp_path / "meta.mcap", metadata={"cosim": {"rate_hz": "fast", "sensors": "[1]"}})
     assert_one_line(cosim_cli("info", str(meta), cwd=tmp_path), 2, "malformed cosim metadata: rate_hz")
@@ -190,3 +235,36 @@ def test_a_binary_road_profile_is_reported_at_its_key(tmp_path: Path) -> None:
     scenario = profiled(tmp_path)
     (tmp_path / "data/road.csv").write_bytes(bytes(range(256)) * 4)
     assert_one_line(cosim_cli("run", str(scenario), cwd=tmp_path), 2, "s.toml: road.profile:", "not a text file")
+
+
+# --------------------------------------------------------------------------- issue 27, item 6: a log cut short
+
+
+def test_a_log_that_cannot_be_finished_says_up_to_when_it_can_be_read(tmp_path: Path) -> None:
+    """The disk fills during a run: here a real limit on the file size (RLIMIT_FSIZE: a write past it fails with
+    EFBIG, File too large, Python ignoring SIGXFSZ), which fails the log's writes as a full disk (ENOSPC) does,
+    in the same place. The run exits 1 with one line that names the error and the simulated time up to which the
+    file can be read: what a reader of the file finds."""
+    import resource
+    import subprocess
+    import sys
+
+    from _robust import cli_env
+
+    from cosim.log import read_log
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+
+    result = subprocess.run([sys.executable, "-m", "cosim", "run", "paper-double-tee", "--out", "cut.mcap",
+                             "--quiet"], capture_output=True, text=True, cwd=tmp_path, env=cli_env(), timeout=600,
+                            preexec_fn=limit)
+    line = assert_one_line(result, 1, "cut.mcap: writing the log failed", "File too large",
+                           "the log cut.mcap is cut short: it can be read up to t = ",
+                           "of the 20 s simulated (and has no final status)")
+    assert "finished" not in line and "status \"error\"" not in line
+    stated = float(line.split("read up to t = ")[1].split(" s")[0])
+    log = read_log(tmp_path / "cut.mcap")
+    assert log.truncated and log.final_status["state"] != "finished"
+    assert 0 < stated < 20 and max(t for t, _ in log.messages["/cosim/sensors"]) / 1e9 == stated
+    assert (tmp_path / "cut.mcap").stat().st_size <= 200_000

@@ -5,7 +5,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
-from _craft import rewrite
+from _craft import edit_protobuf, rewrite
 from _robust import PROFILED, ROAD_CSV, cosim_cli, write
 
 from cosim.log import TOPIC_SENSORS
@@ -86,17 +86,18 @@ def test_modes_plot_and_validate_refuse_to_overwrite(tmp_path: Path) -> None:
 
 
 def test_a_log_that_fails_half_way_through_an_export_leaves_no_csv(profiled_log: Path, tmp_path: Path) -> None:
-    """The 300th sensor sample is crafted to be a string: the export stops there, and nothing is left."""
+    """The 300th sensor sample is crafted to be NaN (a valid protobuf double): the export stops there, and nothing
+    is left."""
     seen = {"n": 0}
 
-    def spoil(topic: str, message: dict) -> dict:
+    def spoil(schema, topic: str, data: bytes) -> bytes:  # noqa: ANN001
         if topic == TOPIC_SENSORS:
             seen["n"] += 1
             if seen["n"] == 300:
-                return {**message, "mid": "1.0"}
-        return message
+                return edit_protobuf(schema, data, lambda m: setattr(m, "mid", float("nan")))
+        return data
 
-    crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", message=spoil)
+    crafted = rewrite(profiled_log, tmp_path / "crafted.mcap", raw=spoil)
     refused(cosim_cli("export", str(crafted), "--csv", str(tmp_path / "out.csv"), cwd=tmp_path),
             "/cosim/sensors", "mid: expected a finite number")
     assert not (tmp_path / "out.csv").exists()

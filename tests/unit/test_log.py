@@ -5,7 +5,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-import jsonschema
 import numpy as np
 import pytest
 
@@ -26,6 +25,7 @@ from cosim.log import (
     file_is_complete,
     read_log,
 )
+from cosim.log.proto import TOPIC_MESSAGES
 from cosim.log.scene import SceneWriter, plan_scene, scene_sensors
 from cosim.log.schemas import TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM
 
@@ -35,14 +35,22 @@ SEC = SectionProperties(A=4.8, y_c=0.0, z_c=0.0, I_y=1.6, I_z=60.0, I_yz=0.0, y_
 SENSORS = [Sensor("mid", 15.0, 0.0), Sensor("edge_acc", 15.0, 6.0, "acceleration")]
 
 
-def schema_validator(text: bytes, cache: dict[bytes, Any]) -> Any:
-    """A JSON Schema validator for a schema record's text, checked and built once per schema."""
-    if text not in cache:
-        schema = json.loads(text)
-        cls = jsonschema.validators.validator_for(schema)
-        cls.check_schema(schema)
-        cache[text] = cls(schema)
-    return cache[text]
+def stored_schema_decoder(schema: Any, cache: dict[tuple[str, bytes], Any]) -> Any:
+    """A decoder of a channel's messages built from its schema record alone (the ``FileDescriptorSet`` in the file),
+    with the protobuf runtime, as Foxglove and the ``mcap`` CLI read them: an independent check of the encoding."""
+    if (schema.name, schema.data) not in cache:
+        from google.protobuf import descriptor_pb2, json_format, message_factory
+
+        files = descriptor_pb2.FileDescriptorSet.FromString(schema.data).file
+        cls = message_factory.GetMessages(list(files))[schema.name]
+
+        def decode(data: bytes) -> dict:
+            message = cls.FromString(data)
+            return json_format.MessageToDict(message, preserving_proto_field_name=True)
+
+        cache[(schema.name, schema.data)] = decode
+    return cache[(schema.name, schema.data)]
+
 
 
 def _logged_run(path, duration=2.0, scene=False, **kwargs):
@@ -94,10 +102,9 @@ def test_every_message_validates_against_its_schema(tmp_path):
         validators: dict[bytes, Any] = {}
         counts: dict[str, int] = {}
         for schema, channel, message in reader.iter_messages():
-            assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
-            stored = json.loads(schema.data)
-            assert stored["title"] == schema.name and foxglove_problems(stored) == [], channel.topic
-            schema_validator(schema.data, validators).validate(json.loads(message.data))
+            assert schema.encoding == "protobuf" and channel.message_encoding == "protobuf"
+            assert schema.name == TOPIC_MESSAGES[channel.topic], channel.topic
+            assert isinstance(stored_schema_decoder(schema, validators)(message.data), dict)
             counts[channel.topic] = counts.get(channel.topic, 0) + 1
     assert counts[TOPIC_SENSORS] > 100
     # the scene: at t = 0 and every 0.1 s; the static part and the transform once

@@ -3,7 +3,6 @@ vehicles against the logged contact forces, its scales against closed forms. Rea
 from __future__ import annotations
 
 import numpy as np
-import orjson
 import pytest
 
 from cosim.core.bridge import PointLoad, build_bridge
@@ -14,7 +13,7 @@ from cosim.core.simulation import SolverSettings, simulate
 from cosim.core.traffic import ScriptedTraffic, ScriptedVehicle
 from cosim.core.vehicles import HalfCar, QuarterCar
 from cosim.core.vehicles.half_car import Axle
-from cosim.log import TOPIC_SENSORS, TOPIC_VEHICLES, BlockLogger, LogRecorder, read_log
+from cosim.log import TOPIC_SENSORS, TOPIC_VEHICLES, BlockLogger, LogRecorder, proto, read_log
 from cosim.log.scene import (
     SAG_OF_SPAN,
     SCENE_MAX_DURATION,
@@ -35,9 +34,13 @@ class Scenes:
 
     def __init__(self) -> None:
         self.messages: list[dict] = []
+        self._decode = proto.decoder("foxglove.SceneUpdate", b"")  # Foxglove's own schema, from its package
+
+    def spec(self, topic: str) -> proto.MessageSpec:
+        return proto.spec_of(proto.TOPIC_MESSAGES[topic])
 
     def write_encoded(self, topic, times, datas) -> None:  # noqa: ANN001 - LogRecorder's signature
-        self.messages += [orjson.loads(d) for d in datas]
+        self.messages += [self._decode(d) for d in datas]
 
     def write(self, topic, t, message) -> None:  # noqa: ANN001
         self.messages.append(message)
