@@ -21,6 +21,15 @@ step, BLAS pinned to one thread:
    re-applied every step, ``analyze(1, dt)`` per step. It is checked against
    cosim's moving-force result first.
 
+4. Decks given by their modes (issue 26, item 7): cosim's step on a
+   :class:`cosim.core.modal_bridge.ModalBridge` (the paper bridge's own modes
+   through ``from_beam``, 50, 100 and 200 of them) side by side with the
+   beam's modal basis on the same modes, with 0, 8 and 64 quarter-cars; and
+   the same step on synthetic grid decks of 1e3, 1e4 and 1e5 points (20
+   modes, 8 quarter-cars), which shows what locating each contact point on
+   the deck costs as the deck grows. These report the median of the
+   repetitions as well as the best.
+
 Every configuration is set up once (not timed), then timed ``--reps`` times in
 interleaved rounds (round 1 runs every configuration once, then round 2, ...),
 and the best repetition counts: on a shared machine each configuration gets
@@ -62,10 +71,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a check
 import numba  # noqa: E402
 from _report import write_report  # noqa: E402 - benchmarks/, on sys.path when a script runs
 
+from cosim.bridges import from_beam  # noqa: E402
 from cosim.core import kernels  # noqa: E402
 from cosim.core.bases import make_basis  # noqa: E402
 from cosim.core.bridge import BridgeModel, ExplicitDamping, build_bridge  # noqa: E402
 from cosim.core.coupling import CoupledSystem  # noqa: E402
+from cosim.core.modal_bridge import ModalBridge, ModalRatios  # noqa: E402
+from cosim.core.modal_deck import ModalDeck  # noqa: E402
 from cosim.core.schemes import Scheme  # noqa: E402
 from cosim.core.sensors import Sensor  # noqa: E402
 from cosim.core.traffic import TrafficBlock  # noqa: E402
@@ -116,9 +128,14 @@ class Case:
     steps: int
     run: Callable[[], tuple[float, float]] = field(repr=False)
     note: str = ""
-    table: str = "main"  # "main" or "anatomy"
+    table: str = "main"  # "main", "anatomy" or "decks"
     wall: float = math.inf  # best repetition
     cpu: float = math.nan  # its process CPU time
+    walls: list[float] = field(default_factory=list)  # every repetition
+
+    @property
+    def median_us_per_step(self) -> float:
+        return 1e6 * float(np.median(self.walls)) / self.steps if self.walls else math.nan
 
     @property
     def us_per_step(self) -> float:
@@ -153,6 +170,7 @@ def measure(cases: list[Case], reps: int) -> None:
         t0 = time.perf_counter()
         for case in cases:
             wall, cpu = case.run()
+            case.walls.append(wall)
             if wall < case.wall:
                 case.wall, case.cpu = wall, cpu
         print(f"  round {r + 1}/{reps} done ({time.perf_counter() - t0:.1f} s)", flush=True)
@@ -600,6 +618,81 @@ def opensees_cases(report: Report, paper: BridgeModel, s: Settings) -> list[Case
 
 
 # ----------------------------------------------------------------- report
+DECK_MODES = (50, 100, 200)
+DECK_VEHICLES = (0, 8, 64)
+DECK_POINTS = ((64, 16), (200, 50), (632, 158))  # grids of ~1e3, 1e4, 1e5 points (along x, across)
+DECK_POINT_MODES = 20
+
+
+def synthetic_deck(n_s: int, n_r: int, length: float, width: float, n_modes: int) -> ModalDeck:
+    """A grid deck of ``n_s x n_r`` points with plate-like modes sin(i pi x / L) cos(k pi y / B) (i, k = 1, 2, ...)
+    at ascending made-up frequencies: a stand-in of a shell model's slab nodes, for timing only."""
+    x, y = np.meshgrid(np.linspace(0.0, length, n_s), np.linspace(-width / 2, width / 2, n_r), indexing="ij")
+    pairs = sorted(((i, k) for i in range(1, n_modes + 1) for k in range(0, 4)), key=lambda p: p[0] ** 2 + 4 * p[1])
+    pairs = pairs[:n_modes]
+    phi = np.array([np.sin(i * np.pi * x / length) * np.cos(k * np.pi * (y / width + 0.5)) for i, k in pairs])
+    f_hz = 2.0 * np.arange(1, n_modes + 1)
+    return ModalDeck(points=np.column_stack([x.ravel(), y.ravel()]), f_hz=f_hz,
+                     phi=phi.reshape(n_modes, -1) * 1e-3, source=f"synthetic {n_s} x {n_r} grid")
+
+
+def deck_factory(bridge: ModalBridge) -> tuple[Callable[[], CoupledSystem], int]:
+    """A maker of fresh coupled systems on a deck given by its modes (one mid-span sensor)."""
+    scheme = Scheme.newmark()
+    b = make_basis(bridge, DT, scheme, "modal")
+    sensors = (Sensor("mid", bridge.length / 2, 0.0, "displacement"),)
+    return (lambda: CoupledSystem(bridge, b, scheme, DT, sensors=sensors)), b.n
+
+
+def deck_cases(report: Report, paper: BridgeModel, s: Settings) -> list[Case]:
+    """Modal decks against the beam's modal basis on the same modes; decks of growing point counts."""
+    print("decks: building modal decks and bases", flush=True)
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else math.nan
+    if load > (os.cpu_count() or 1):
+        report.notes.append(f"The machine was shared and loaded (load average {load:.1f} on {os.cpu_count()} "
+                            "logical CPUs when the decks were set up): medians and bests of one configuration "
+                            "can differ by 2x; the bests are the runs that had a core to themselves.")
+    cases = []
+    # Mass-proportional damping only (the paper's alpha): with its beta the beam's modes above ~110 Hz are damped
+    # beyond critical (zeta >= 1), which a modes file cannot hold (from_beam refuses them). The cost of a step
+    # does not depend on the damping's values.
+    damping = ExplicitDamping(paper.alpha, 0.0)
+    beam_bridge = build_bridge(spans=paper.spans, elements_per_span=paper.n_elements, material=paper.material,
+                               section=paper.section, supports=paper.supports, damping=damping)
+    for n_modes in DECK_MODES:
+        beam_make, n = cosim_factory(beam_bridge, "modal", n_modes)
+        deck = ModalBridge(from_beam(beam_bridge, n_modes=n_modes), damping)
+        deck_make, n_deck = deck_factory(deck)
+        points = len(deck.deck.points)
+        for q in DECK_VEHICLES:
+            block = fleet(q, QUARTER_CAR, s.cosim_steps, paper.length)
+            beam = cosim_case(f"beam-modes/qc/{n_modes}/{q}", f"beam modal basis, {n_modes} modes", "quarter-car",
+                              paper, beam_make, n, block)
+            modal = cosim_case(f"deck-modes/qc/{n_modes}/{q}", f"modal deck (from_beam, {points} points), "
+                               f"{n_modes} modes", "quarter-car", paper, deck_make, n_deck, block)
+            for case in (beam, modal):
+                case.table = "decks"
+            cases += [beam, modal]
+        # the two give the same numbers (tests/verification/test_modal_beam.py): checked here on the fleet of 8
+        block = fleet(8, QUARTER_CAR, 200, paper.length)
+        a, b = beam_make().advance(block).sensors[:, 0], deck_make().advance(block).sensors[:, 0]
+        report.check(f"modal deck = beam modal basis, {n_modes} modes, 8 quarter-cars, mid-span w",
+                     f"{np.max(np.abs(a - b)) / np.max(np.abs(a)):.1e} of the peak", "from_beam's rows are the beam's")
+    width = paper.section.deck_y[1] - paper.section.deck_y[0]
+    for n_s, n_r in DECK_POINTS:
+        t0 = time.perf_counter()
+        deck = ModalBridge(synthetic_deck(n_s, n_r, paper.length, width, DECK_POINT_MODES), ModalRatios(0.02))
+        make, n = deck_factory(deck)
+        built = time.perf_counter() - t0
+        block = fleet(8, QUARTER_CAR, s.cosim_steps, paper.length)
+        case = cosim_case(f"deck-points/qc/{n_s * n_r}/8", f"synthetic grid deck, {n_s} x {n_r} = {n_s * n_r} "
+                          "points", "quarter-car", paper, make, n, block)
+        case.table = "decks"
+        case.note = (case.note + "; " if case.note else "") + f"deck and basis built in {built:.1f} s (not timed)"
+        cases.append(case)
+    return cases
+
+
 def _ratio(report: Report, num: str, den: str) -> float | None:
     a, b = report.get(num), report.get(den)
     return a.us_per_step / b.us_per_step if a and b else None
@@ -651,15 +744,50 @@ def ratios(report: Report, s: Settings) -> list[tuple[str, str, str, str]]:
     return out
 
 
+def deck_markdown(report: Report, decks: list[Case]) -> list[str]:
+    """The modal decks' tables: per mode count and fleet, the deck beside the beam's modal basis; per point count."""
+    lines = [
+        "", "## Decks given by their modes (issue 26, item 7)", "",
+        "The paper bridge's own modes imported through `from_beam` (41 nodes x 5 lines across = 205 points, a "
+        "grid: bicubic Hermite cells, docs/theory.md §13.3) and run as a `ModalBridge` (`DeckModalBasis`: contact "
+        "rows from the mode surface, `cosim.core.surface_contact`), beside the beam's own modal basis "
+        "(`ModalBasis`: contact rows from the beam's elements) on the same modes, the same quarter-cars and the "
+        "same blocks. Microseconds per step: the median of the repetitions (best in brackets).", "",
+        "| modes | vehicles | beam modal basis, us/step | modal deck, us/step | deck / beam |",
+        "|---:|---:|---:|---:|---:|",
+    ]
+    for n_modes in DECK_MODES:
+        for q in DECK_VEHICLES:
+            beam, deck = report.get(f"beam-modes/qc/{n_modes}/{q}"), report.get(f"deck-modes/qc/{n_modes}/{q}")
+            if beam is None or deck is None:
+                continue
+            lines.append(f"| {n_modes} | {q} | {beam.median_us_per_step:.1f} ({beam.us_per_step:.1f}) | "
+                         f"{deck.median_us_per_step:.1f} ({deck.us_per_step:.1f}) | "
+                         f"{deck.median_us_per_step / beam.median_us_per_step:.2f} |")
+    points = [c for c in decks if c.key.startswith("deck-points/")]
+    if points:
+        lines += [
+            "", f"Locating the contact points: synthetic grid decks ({DECK_POINT_MODES} modes, 8 quarter-cars, "
+            "no triangles: the grid's rectangle is the surface), from 1e3 to 1e5 points. Each axle's cell is "
+            "found by bisection on the grid's lines along and across (O(log n)); a 100-fold larger deck that "
+            "costs the same per step shows the lookup is not a scan of the points.", "",
+            "| deck | points | us/step, median (best) | note |", "|---|---:|---:|---|",
+        ]
+        lines += [f"| {c.solver} | {c.key.split('/')[2]} | {c.median_us_per_step:.1f} ({c.us_per_step:.1f}) | "
+                  f"{c.note} |" for c in points]
+    return lines
+
+
 def markdown(report: Report, machine: dict[str, str], s: Settings, started: str, wall: float) -> str:
     main = [c for c in report.cases if c.table == "main"]
     anatomy = [c for c in report.cases if c.table == "anatomy"]
+    decks = [c for c in report.cases if c.table == "decks"]
     lines = [
         "# Cost of one coupled time step",
         "",
         f"`python benchmarks/bench_step.py{' --quick' if s.quick else ''}`, {started}, {wall:.0f} s in all. "
         f"dt = {DT * 1e3:g} ms, Newmark average acceleration. Microseconds of wall time per step, best of "
-        f"{s.reps} repetitions taken in interleaved rounds.",
+        f"{s.reps} repetitions taken in interleaved rounds (the decks' tables: their median, and the best).",
         "",
         "## Machine",
         "",
@@ -667,6 +795,8 @@ def markdown(report: Report, machine: dict[str, str], s: Settings, started: str,
         "|---|---|",
         *[f"| {k} | {v} |" for k, v in machine.items()],
         "",
+    ]
+    main_head = [
         "## Microseconds per step",
         "",
         "Paper bridge (40 m double-tee, Rayleigh 2 %) unless the element count says otherwise; other meshes "
@@ -679,14 +809,19 @@ def markdown(report: Report, machine: dict[str, str], s: Settings, started: str,
         "| solver | vehicle model | elements | vehicles | DOFs | us/step | steps timed | CPU/wall | note |",
         "|---|---|---:|---:|---:|---:|---:|---:|---|",
     ]
+    if main:
+        lines += main_head
     for c in main:
         us = f"{c.us_per_step:.1f}" if math.isfinite(c.wall) else "not run"
         share = f"{100 * c.cpu / c.wall:.0f} %" if math.isfinite(c.wall) and c.wall > 0 else ""
         lines.append(f"| {c.solver} | {c.model} | {c.elements} | {c.vehicles} | {c.dofs} | {us} | {c.steps} | "
                      f"{share} | {c.note} |")
-    lines += ["", "## Ratios measured in this run", "", "| ratio | measured | target / reference | |",
-              "|---|---:|---|---|"]
-    lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in ratios(report, s)]
+    if main:
+        lines += ["", "## Ratios measured in this run", "", "| ratio | measured | target / reference | |",
+                  "|---|---:|---|---|"]
+        lines += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in ratios(report, s)]
+    if decks:
+        lines += deck_markdown(report, decks)
     if anatomy:
         lines += [
             "", "## Where the direct step's time goes (paper bridge)", "",
@@ -703,7 +838,7 @@ def markdown(report: Report, machine: dict[str, str], s: Settings, started: str,
     lines += [f"| {a} | {b} | {c} |" for a, b, c in report.checks]
     lines += ["", "## Notes", ""]
     lines += [f"- {n}" for n in report.notes]
-    lines += [
+    lines += [] if not main else [
         "- cosim: `CoupledSystem.advance` on one block of steps, a fresh system per repetition; the basis "
         "(factorisation, dense inverse or modes) is built once and not timed, and a warm-up call compiled "
         "the numba kernels first. The time includes the per-block Python work (road lookup, output arrays) "
@@ -716,6 +851,15 @@ def markdown(report: Report, machine: dict[str, str], s: Settings, started: str,
         "0.25); each step removes and re-creates the load pattern with each force lumped linearly to the two "
         "nodes of its element (vertical force and the torque of its lateral offset), then `analyze(1, dt)`. "
         "Model building is not timed.",
+    ]
+    if decks:
+        lines += [
+            "- Decks: `CoupledSystem.advance` on one block, a fresh system per repetition, the basis built once; "
+            "the beam for these rows keeps the paper bridge's mesh and mass-proportional damping alpha only "
+            "(with its beta the beam's modes above ~110 Hz are damped beyond critical, which a modes file cannot "
+            "hold: from_beam refuses them). The cost of a step does not depend on the damping's values.",
+        ]
+    lines += [
         "- Shared machine with few cores: differences of ~10-20 % between runs are noise; the ratios are "
         "taken within one run, with the repetitions interleaved.",
     ]
@@ -727,7 +871,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer steps and meshes (well under a minute)")
     parser.add_argument("--out", type=Path, default=DEFAULT_OUT, help="Markdown report (default: %(default)s)")
     parser.add_argument("--reps", type=int, default=3, help="repetitions per configuration; the best counts")
-    parser.add_argument("--skip", nargs="*", default=(), choices=("cosim", "naive", "opensees"),
+    parser.add_argument("--skip", nargs="*", default=(), choices=("cosim", "naive", "opensees", "decks"),
                         help="parts to leave out")
     args = parser.parse_args(argv)
     if args.reps < 1:
@@ -747,6 +891,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         report.cases += naive_cases(report, paper, s)
     if "opensees" not in args.skip:
         report.cases += opensees_cases(report, paper, s)
+    if "decks" not in args.skip:
+        report.cases += deck_cases(report, paper, s)
     print(f"timing {len(report.cases)} configurations, {s.reps} interleaved rounds", flush=True)
     measure(report.cases, s.reps)
     text = markdown(report, machine, s, started, time.perf_counter() - t0)
