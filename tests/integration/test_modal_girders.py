@@ -52,7 +52,7 @@ def _flexibility(deck: ModalDeck, points: list[tuple[float, float]], x: float, y
 
 
 #: The committed file against the model's modes computed now: the same model, the same eigen solver
-#: (ARPACK), so the frequencies agree to its convergence (measured 0 to 1e-12) and each shape to a sign.
+#: (ARPACK): measured bit for bit here (0); the tolerance allows another BLAS. Shapes up to a sign.
 SAME_MODES = 1e-8
 #: The first frequency against the whole cross-section as one simply supported Euler-Bernoulli beam, (pi/2L^2)
 #: sqrt(EI/m), I and m of the slab and the five girders together (the plates by cosim's section solver): the
