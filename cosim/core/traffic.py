@@ -190,7 +190,7 @@ class TrafficSource(abc.ABC):
 
     def follow_paths(self) -> None:  # noqa: B027 - a no-op by default: most sources' wheels keep their y
         """From now on, blocks carry each contact point's lateral path at every step (a deck given by its
-        modes reads a curved lane's path: docs/theory.md §13.4). Sources whose vehicles keep their lateral
+        modes reads a curved lane's path: docs/theory.md §13.8). Sources whose vehicles keep their lateral
         offset (scripted vehicles, records) have nothing more to say and ignore it; sources of frames
         (:class:`FramedSource`) follow."""
 
@@ -627,7 +627,7 @@ def _frame_before(frame: Frame | None, ids: list[str], keep: npt.NDArray[np.int6
 @compiled(nogil=True)
 def lateral_paths(FX: np.ndarray, FY: np.ndarray, seen: np.ndarray, X: np.ndarray, r_of: np.ndarray,
                   x_before: np.ndarray, y_before: np.ndarray, seen_before: np.ndarray) -> np.ndarray:
-    """Each contact point's path at every step, (K, q, 5): y, 1, dy/dx, 0, d2y/dx2 (docs/theory.md §13.4).
+    """Each contact point's path at every step, (K, q, 5): y, 1, dy/dx, 0, d2y/dx2 (docs/theory.md §13.8).
 
     Between frames r and r + 1 the lateral offset is the quadratic in x through the frames r - 1, r and r + 1
     (the frame before the block for r = 0): exact on a parabola, O(h^3) times the lane's third derivative on any

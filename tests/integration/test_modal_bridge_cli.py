@@ -167,3 +167,99 @@ def test_a_damaged_modes_file_is_one_line_naming_the_file_and_the_array(tmp_path
     line = result.stderr.strip()
     assert "\n" not in line and line.startswith("cosim: error: deck.toml: bridge.modes: ") and "f_hz" in line, line
     assert not (tmp_path / "run.mcap").exists()
+
+
+# ------------------------------------------------------------------------------- frame = "network"
+ANGLE = np.radians(30.0)  # the bridge runs 30 degrees north of east: nothing lines up with the network's axes
+DIRECTION = np.array([np.cos(ANGLE), np.sin(ANGLE)])
+
+
+def _at(s: float) -> str:
+    x, y = s * DIRECTION + np.array([500.0, 300.0])
+    return f'x="{x:.6f}" y="{y:.6f}"'
+
+
+ROTATED_NODES = f"""<nodes>
+    <node id="W" {_at(-150.0)}/>
+    <node id="A" {_at(0.0)} type="priority"/>
+    <node id="B" {_at(40.0)} type="priority"/>
+    <node id="E" {_at(190.0)}/>
+</nodes>
+"""
+_ROAD = 'numLanes="1" speed="16.0" width="3.5"'
+ROTATED_EDGES = "<edges>\n" + "\n".join(
+    f'    <edge id="{e}" from="{a}" to="{b}" {_ROAD}/>'
+    for e, a, b in (("in", "W", "A"), ("deck", "A", "B"), ("out", "B", "E"),
+                    ("-out", "E", "B"), ("-deck", "B", "A"), ("-in", "A", "W"))) + "\n</edges>\n"
+ROTATED_ROUTES = """<routes>
+    <vType id="lorry" vClass="truck" maxSpeed="16" sigma="0"/>
+    <vType id="car" vClass="passenger" maxSpeed="16" sigma="0"/>
+    <vehicle id="east" type="lorry" depart="0" departSpeed="max"><route edges="in deck out"/></vehicle>
+    <vehicle id="west" type="lorry" depart="2" departSpeed="max"><route edges="-out -deck -in"/></vehicle>
+    <vehicle id="car" type="car" depart="4" departSpeed="max"><route edges="in deck out"/></vehicle>
+</routes>
+"""
+ROTATED_CONFIG = """<configuration>
+    <input><net-file value="rot.net.xml"/><route-files value="rot.rou.xml"/></input>
+</configuration>
+"""
+ROTATED_TRAFFIC = """
+[traffic]
+sumo_config = "rot.sumocfg"
+edges = ["deck", "-deck"]
+step = 0.05
+end = 25.0
+[solver]
+dt = 0.005
+"""
+
+
+def test_a_network_frame_deck_is_placed_where_its_points_are(tmp_path: Path) -> None:
+    """frame = "network": the beam's modes, their points moved to where the bridge lies in a network turned by
+    30 degrees, give the run of the same modes in the bridge frame (placement: a rotation and a shift, exact
+    to round-off; 1e-9 of the peak), with real SUMO traffic both ways."""
+    import subprocess
+
+    import sumo
+
+    from cosim.sumo.network import locate_bridge
+
+    (tmp_path / "rot.nod.xml").write_text(ROTATED_NODES)
+    (tmp_path / "rot.edg.xml").write_text(ROTATED_EDGES)
+    subprocess.run([str(Path(sumo.SUMO_HOME) / "bin" / "netconvert"), "--node-files", "rot.nod.xml",
+                    "--edge-files", "rot.edg.xml", "-o", "rot.net.xml", "--offset.disable-normalization", "true",
+                    "--no-turnarounds", "true", "--no-warnings", "true"], cwd=tmp_path, check=True,
+                   capture_output=True, timeout=60)
+    (tmp_path / "rot.rou.xml").write_text(ROTATED_ROUTES)
+    (tmp_path / "rot.sumocfg").write_text(ROTATED_CONFIG)
+    axis = locate_bridge(tmp_path / "rot.net.xml", ["deck", "-deck"]).axis
+    length = axis.length
+    beam = testing.scenario({"bridge": testing.bridge(length, elements_per_span=12, deck_y=(-4.0, 4.0)),
+                             "solver": {"duration": 1.0}}).build_beam()
+    deck = from_beam(beam, n_modes=12, lateral=3)
+    write_modes(tmp_path / "beam.npz", deck)
+    # Values only in both files: a network-frame deck takes no slopes (they would be along the bridge's x).
+    arrays = {k: v for k, v in np.load(tmp_path / "beam.npz").items() if k not in ("frame", "phi_x", "phi_x_minus")}
+    np.savez(tmp_path / "bridge.npz", **arrays)
+    e, n = axis.unit()
+    network = deck.points[:, :1] * e + deck.points[:, 1:] * n + np.asarray(axis.start)
+    arrays["x"], arrays["y"] = network[:, 0], network[:, 1]
+    np.savez(tmp_path / "network.npz", **arrays)
+    sensors = '[[sensors]]\nname = "mid"\nx = {x}\ny = 1.6\n[[sensors]]\nname = "edge_acc"\nx = {x}\ny = -4.0\n' \
+              'quantity = "acceleration"\n'.format(x=round(length / 2, 6))
+    runs = {}
+    for frame, file in (("bridge", "bridge.npz"), ("network", "network.npz")):
+        text = (f'name = "{frame}"\n[bridge]\nmodes = "{file}"\nframe = "{frame}"\n[bridge.damping]\nratio = 0.02\n'
+                + sensors + ROTATED_TRAFFIC)
+        if frame == "bridge":
+            text = text.replace('edges = ["deck", "-deck"]',
+                                f"axis = [[{axis.start[0]!r}, {axis.start[1]!r}], [{axis.end[0]!r}, {axis.end[1]!r}]]")
+        scenario = parse_scenario(text, f"{frame}.toml", base_dir=tmp_path)
+        assert scenario.bridge.length == pytest.approx(length, rel=1e-12)
+        runs[frame] = testing.run(scenario)
+    bridge_run, network_run = runs["bridge"], runs["network"]
+    assert sorted({v.split("#")[0] for v in bridge_run.vehicle_ids}) == ["car", "east", "west"]
+    assert network_run.vehicle_ids == bridge_run.vehicle_ids
+    for name in ("mid", "edge_acc"):
+        ref = bridge_run[name]
+        assert np.max(np.abs(network_run[name] - ref)) <= 1e-9 * np.max(np.abs(ref)), name

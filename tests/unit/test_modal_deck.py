@@ -299,3 +299,44 @@ def test_sizes_are_bounded_before_anything_is_built(monkeypatch):
     monkeypatch.setenv("COSIM_MAX_MODE_VALUES", "20")
     with pytest.raises(ConfigError, match=r"^deck.npz: phi: 24 values \(2 modes x 12 points\) is more than"):
         ModalDeck(**good())
+
+
+def test_the_compiled_step_reads_a_curved_paths_slope_and_curvature():
+    """On a deck given by its modes the compiled step's contact rows along a curved wheel path y(x) are
+    d/dx and d2/dx2 of w(x, y(x)) (docs/theory.md §13.8): w_x + y' w_y and w_xx + 2 y' w_xy + y'^2 w_yy + y'' w_y.
+    Reference: the closed form for a bicubic field on a parabolic path, which the grid reproduces exactly
+    (round-off, 1e-10 of the largest value)."""
+    from cosim.core import kernels
+    from cosim.core.modal_bridge import ModalBridge
+    from cosim.core.surface_contact import surface_rows
+
+    x = np.array([0.0, 1.5, 4.0, 5.0, 8.5, 12.0])
+    y = np.array([-3.0, -1.0, 0.5, 3.0])
+    pts = np.array([(a, b) for a in x for b in y])
+
+    def cubic(px, py):
+        return (px**3 - 4 * px**2 + px) * (0.2 * py**3 - py + 2)
+
+    deck = ModalBridge(ModalDeck(pts, [1.0], cubic(pts[:, 0], pts[:, 1])[None])).kernel_deck()
+    c0, c1, c2 = -1.0, 0.3, -0.02
+    qx = np.linspace(0.2, 11.7, 200)
+    qy, slope, curv = c0 + c1 * qx + c2 * qx**2, c1 + 2 * c2 * qx, np.full_like(qx, 2 * c2)
+    path = np.zeros((1, len(qx), 5))
+    path[0, :, 0], path[0, :, 1], path[0, :, 2], path[0, :, 4] = qy, 1.0, slope, curv
+    kin = kernels.Kinematics(qx[None], np.full((1, len(qx)), 10.0), np.zeros((1, len(qx))), qy,
+                             np.zeros((1, len(qx))), np.zeros((1, len(qx))), path)
+    elems, rv = np.zeros(len(qx), dtype=np.int64), np.zeros((len(qx), 3, 1))
+    surface_rows(kin, 0, deck, elems, rv, np.empty((3, 4)), np.empty((3, 4)), np.empty((3, 4, 4)))
+    gx = (3 * qx**2 - 8 * qx + 1) * (0.2 * qy**3 - qy + 2)
+    gy = (qx**3 - 4 * qx**2 + qx) * (0.6 * qy**2 - 1)
+    hxx = (6 * qx - 8) * (0.2 * qy**3 - qy + 2)
+    hxy = (3 * qx**2 - 8 * qx + 1) * (0.6 * qy**2 - 1)
+    hyy = (qx**3 - 4 * qx**2 + qx) * 1.2 * qy
+    exact = np.column_stack([cubic(qx, qy), gx + slope * gy,
+                             hxx + 2 * slope * hxy + slope**2 * hyy + curv * gy])
+    assert np.all(elems == 0)
+    assert np.max(np.abs(rv[:, :, 0] - exact)) <= 1e-10 * np.max(np.abs(exact))
+    # The straight path (no path array) reads the rows along x at the wheel's y.
+    straight = kin._replace(path=np.zeros((0, 0, 5)))
+    surface_rows(straight, 0, deck, elems, rv, np.empty((3, 4)), np.empty((3, 4)), np.empty((3, 4, 4)))
+    assert np.max(np.abs(rv[:, :, 0] - np.column_stack([cubic(qx, qy), gx, hxx]))) <= 1e-10 * np.max(np.abs(exact))
