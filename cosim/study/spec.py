@@ -324,6 +324,18 @@ class Study:
             output.pop("csv", None)
             if not output:
                 data.pop("output")
+        # [bridge] modes: the modes file (or CSV folder) goes into the run's folder, as a road profile does
+        bridge = data.get("bridge")
+        if isinstance(bridge, dict) and isinstance(bridge.get("modes"), str):
+            source = self.base_dir / bridge["modes"]
+            name = f"inputs/{Path(bridge['modes']).name}"
+            if source.is_dir():
+                for item in sorted(source.iterdir()):
+                    if item.is_file():
+                        files[f"{name}/{item.name}"] = item.read_bytes()
+            else:
+                files[name] = source.read_bytes()
+            data["bridge"] = {**bridge, "modes": name}
         # [road]
         road = dict(data.get("road") or {})
         if "road_class" in params:

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from cosim.core.bridge import BridgeModel
 from cosim.core.quasistatic import daf, quasi_static
 from cosim.core.traffic import FrameTraffic, ScriptedTraffic
 from cosim.run.scenario import Scenario
@@ -89,7 +90,9 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         traffic = logged_traffic(outcome.log_path, bridge.length, scenario.traffic.step, until=outcome.duration)
     else:
         traffic = scenario.build_vehicles()
-    qs = quasi_static(bridge, traffic, outcome.duration, scenario.solver.dt, sensors, scenario.solver.gravity)
+    # A deck given by its modes has no influence lines: no static peak, no DAF (docs/modal-decks.md).
+    qs = (quasi_static(bridge, traffic, outcome.duration, scenario.solver.dt, sensors, scenario.solver.gravity)
+          if isinstance(bridge, BridgeModel) else None)
     row: dict[str, Any] = {"duration": outcome.duration, "steps": result.steps}
     for name in names:
         lo, hi = result.sensor_min[name], result.sensor_max[name]
@@ -101,8 +104,8 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         for q in percentiles:
             row[f"{name}.p{number_text(q)}"] = float(np.percentile(values, q)) if len(values) else None
         row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
-        row[f"{name}.static_peak"] = qs.peak[name]
-        row[f"{name}.daf"] = daf(peak, qs.peak[name])
+        row[f"{name}.static_peak"] = qs.peak[name] if qs is not None else None
+        row[f"{name}.daf"] = daf(peak, qs.peak[name]) if qs is not None else None
     for name, fat in outcome.fatigue.items():
         per_year = fat.damage_per_year
         if vehicles_per_year is not None:
@@ -120,8 +123,8 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
     row.update({
         "vehicles": len(result.vehicle_ids),
         "max_on_deck": result.max_on_deck,
-        "heaviest_kg": qs.heaviest,
-        "heaviest_id": qs.heaviest_id,
+        "heaviest_kg": qs.heaviest if qs is not None else None,
+        "heaviest_id": qs.heaviest_id if qs is not None else None,
         "liftoff_events": result.liftoff_events,
         "liftoff_steps": result.liftoff_steps,
         "wall_time": outcome.wall_time,

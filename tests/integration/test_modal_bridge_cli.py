@@ -263,3 +263,30 @@ def test_a_network_frame_deck_is_placed_where_its_points_are(tmp_path: Path) -> 
     for name in ("mid", "edge_acc"):
         ref = bridge_run[name]
         assert np.max(np.abs(network_run[name] - ref)) <= 1e-9 * np.max(np.abs(ref)), name
+
+
+def test_a_study_runs_on_a_deck_given_by_its_modes(tmp_path: Path) -> None:
+    """``cosim study`` on a modes file: the rows are the beam's own modal-basis study's (from_beam: the same
+    numbers, 1e-9 of the peak, tests above), without a static peak or DAF (no influence lines)."""
+    from cosim.study import load_study, run_study
+
+    beam_text = (bundled_folder() / "paper-bridge-traffic.toml").read_text()
+    beam_text = beam_text.replace('basis = "direct"', f'basis = "modal"\nmodes = {N_MODES}')
+    start, end = beam_text.index("[bridge]"), beam_text.index("[[sensors]]")
+    beam = parse_scenario(beam_text, "beam.toml", base_dir=tmp_path)
+    write_modes(tmp_path / "deck.npz", from_beam(beam, lateral=3))
+    modal_text = (beam_text[:start] + '[bridge]\nmodes = "deck.npz"\n[bridge.damping]\nratios = [0.02, 0.02]\n'
+                  "modes = [1, 2]\n\n" + beam_text[end:]).replace(f'basis = "modal"\nmodes = {N_MODES}', "")
+    rows = {}
+    for name, text in (("beam", beam_text), ("deck", modal_text)):
+        folder = tmp_path / name
+        folder.mkdir()
+        (folder / "base.toml").write_text(text.replace('"deck.npz"', '"../deck.npz"'))
+        (folder / "study.toml").write_text('[study]\nname = "s"\nbase = "base.toml"\nduration = 40.0\n[sweep]\n'
+                                           "vehicles_per_hour = [900.0]\nseeds = [3]\n")
+        outcome = run_study(load_study(folder / "study.toml", output=folder / "out"), workers=0, plots=False)
+        (rows[name],) = outcome.rows
+    assert rows["deck"]["vehicles"] == rows["beam"]["vehicles"] > 0
+    for key in ("node1.peak", "node3_acc.peak", "moment_mid.peak", "edge_right.rms"):
+        assert rows["deck"][key] == pytest.approx(rows["beam"][key], rel=SAME_RUN), key
+    assert rows["deck"]["node1.daf"] is None and rows["beam"]["node1.daf"] > 0
