@@ -574,7 +574,9 @@ class Scenario(ConfigModel):
         """The finite-element beam model (:func:`cosim.core.bridge.build_bridge`)."""
         bridge = self.bridge
         if bridge.is_modal:
-            raise ConfigError(f"{self._source}: bridge: a deck given by its modes ({bridge.modes}) has no beam model")
+            raise ConfigError(f"{self._source}: bridge: a deck given by its modes ({bridge.modes}) has no beam model: "
+                              "cosim modes and cosim static describe beams (the file's frequencies are in the header "
+                              "of cosim run and in its log's modes.json)")
         section = self.build_section()
         with self.named("bridge"):
             return build_bridge(
