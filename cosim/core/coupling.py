@@ -79,6 +79,15 @@ class BlockReport:
     lifted: npt.NDArray[np.bool_]
     off_surface: npt.NDArray[np.bool_] | None = None
     loads: tuple[LoadRecord, ...] = ()
+    path_y: npt.NDArray[np.float64] | None = None
+
+    @property
+    def lateral(self) -> npt.NDArray[np.float64]:
+        """Each wheel's lateral offset at every step, (K, q), m: its path's on a curved lane (a deck given by
+        its modes follows it), else its ``y`` through the block."""
+        if self.path_y is not None:
+            return self.path_y
+        return np.broadcast_to(self.y, self.x.shape)
 
 
 def _fleet_parameters(models: tuple[VehicleModel, ...], columns: list[list[int]],
@@ -482,7 +491,8 @@ class CoupledSystem:
         self.t += K * self.dt
         self.n_steps += K
         return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
-                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block), block.loads)
+                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block), block.loads,
+                           kin.path[:, :, 0] if len(kin.path) else None)
 
     def _path(self, block: TrafficBlock) -> tuple[np.ndarray, ...]:
         """The block's per-step paths for a deck given by its modes (a beam reads each wheel's ``y``)."""

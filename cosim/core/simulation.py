@@ -221,7 +221,8 @@ class _Collector:
         rows, cols = np.nonzero(report.on_deck & keep[:, None])
         vidx = np.array([self.index_of[v] for v in report.ids], dtype=np.int64)
         values = {
-            "t": times[rows], "vehicle": vidx[cols].astype(float), "x": report.x[rows, cols], "y": report.y[cols],
+            "t": times[rows], "vehicle": vidx[cols].astype(float), "x": report.x[rows, cols],
+            "y": report.lateral[rows, cols],
             "speed": report.v[rows, cols], "acceleration": report.a[rows, cols],
             "body_displacement": report.body_displacement[rows, cols],
             "body_acceleration": report.body_acceleration[rows, cols],

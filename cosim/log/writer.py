@@ -315,7 +315,7 @@ class _PacedTraffic:
 _PER_STEP = ("x", "v", "a", "on_deck", "contact_force", "body_displacement", "body_acceleration", "sensors",
              "lifted", "off_surface")
 #: The :class:`cosim.core.coupling.BlockReport` array of a numeric vehicle field, where the names differ.
-_REPORT_ARRAYS = {"speed": "v", "acceleration": "a"}
+_REPORT_ARRAYS = {"speed": "v", "acceleration": "a", "y": "lateral"}
 
 
 def load_message(t: float, record: Any, speed: float | None = None) -> dict[str, Any]:
@@ -570,7 +570,7 @@ class BlockLogger:
             for k, j in zip(*np.nonzero(went)):
                 t = float(times[k])
                 self.rec.write(TOPIC_EVENTS, t, {"t": t, "vehicle": ids[j], "event": "offdeck",
-                                                 "x": float(report.x[k, j]), "y": float(report.y[j])})
+                                                 "x": float(report.x[k, j]), "y": float(report.lateral[k, j])})
         self._off = {v: bool(off[-1, j]) for j, v in enumerate(ids) if off[-1, j]} if off is not None else {}
         # Only the vehicles on the deck are remembered (a vehicle not in them is off it): the writer holds the
         # few on the deck, not every vehicle of a long run (a year of records is a million).

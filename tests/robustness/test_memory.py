@@ -21,8 +21,8 @@ def test_the_plot_envelope_is_the_min_and_max_of_every_bin(tmp_path: Path) -> No
     t = np.arange(n) * 0.01
     a = np.sin(0.37 * t) + 0.1 * np.sin(41.0 * t)
     with LogRecorder(log, ["a"]) as rec:
-        rec.write_encoded("/cosim/sensors", t.tolist(),
-                          [b'{"t":%r,"a":%r}' % (float(ti), float(ai)) for ti, ai in zip(t, a)])
+        for ti, ai in zip(t.tolist(), a.tolist()):
+            rec.write("/cosim/sensors", ti, {"t": ti, "a": ai})
     bins = 1000
     times, series = sensor_envelope(log, ["a"], open_log(log).end_time, bins)
     assert len(times) == len(series["a"]) == 2 * bins  # whatever the log's length
