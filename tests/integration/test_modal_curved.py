@@ -210,10 +210,16 @@ def run_curved(folder: Path, west_depart: float = 10.0, end: float = 20.0,
 
 
 def lane_s(result, placement, vid: str, n_lane: float) -> tuple[np.ndarray, np.ndarray]:  # noqa: ANN001
-    """A vehicle's logged contact point as its lane's centre-line parameter: t, s. The log gives each step's x
-    (and one lateral offset per block, not the path's), so s is where the lane at n_lane has that x."""
+    """A vehicle's logged contact point as its lane's centre-line parameter: t, s (s is where the lane at n_lane
+    has the logged x). The logged lateral offset is the wheel's path at every step: mapped back to the network,
+    each logged point lies on its lane (within 5 cm: the lane polyline, the axle's trail of 1 m chords and the
+    path quadratic together are about a millimetre; one offset per block put points up to 2 m off)."""
     start, along = placement
     v = result.vehicle(vid)
+    network = start + np.outer(v["x"], along) + np.outer(v["y"], np.array([-along[1], along[0]]))
+    radius = np.hypot(network[:, 0], network[:, 1] - R)  # the arc's centre is (0, R)
+    on_deck = (v["x"] > 1.0) & (v["x"] < (on_arc(np.array([S]), np.array([0.0]))[0] - start) @ along - 1.0)
+    assert np.max(np.abs(radius[on_deck] - (R - n_lane))) < 0.05, vid
     table = np.linspace(-5.0, S + 5.0, 12001)
     x_lane = (on_arc(table, np.full_like(table, n_lane)) - start) @ along
     return v["t"], np.interp(v["x"], x_lane, table)
