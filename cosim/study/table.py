@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from cosim.core.quasistatic import daf, quasi_static
-from cosim.core.traffic import FrameTraffic, ScriptedTraffic
+from cosim.core.traffic import FrameTraffic, ScriptedTraffic, vehicle_of
 from cosim.run.scenario import Scenario
 from cosim.study.folder import TABLE_CSV, TABLE_PARQUET, write_file
 from cosim.study.logs import logged_sensors, logged_traffic
@@ -103,10 +103,12 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
         row[f"{name}.static_peak"] = qs.peak[name]
         row[f"{name}.daf"] = daf(peak, qs.peak[name])
+    # Vehicles, not contact points: a vehicle with its own axles is "id#0", "id#1", ... in result.vehicle_ids.
+    vehicles = len({vehicle_of(contact) for contact in result.vehicle_ids})
     for name, fat in outcome.fatigue.items():
         per_year = fat.damage_per_year
         if vehicles_per_year is not None:
-            per_year = fat.damage * vehicles_per_year / len(result.vehicle_ids) if result.vehicle_ids else None
+            per_year = fat.damage * vehicles_per_year / vehicles if vehicles else None
         row[f"{name}.cycles"] = fat.cycles
         row[f"{name}.damage"] = fat.damage
         row[f"{name}.damage_per_year"] = per_year
@@ -118,7 +120,7 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"gvw.{cls}.sd"] = w.sd
         row[f"gvw.{cls}.max"] = w.high
     row.update({
-        "vehicles": len(result.vehicle_ids),
+        "vehicles": vehicles,
         "max_on_deck": result.max_on_deck,
         "heaviest_kg": qs.heaviest,
         "heaviest_id": qs.heaviest_id,
