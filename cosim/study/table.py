@@ -37,8 +37,8 @@ __all__ = [
 ]
 
 #: Columns that hold text; every other column is numeric.
-TEXT_COLUMNS = ("error", "heaviest_id", "log", "status", "run_id", "road_class", "sumo_config")
-_FIRST = ("run_id", "status", *AXES, "sumo_seed", "road_seed", "duration", "steps")
+TEXT_COLUMNS = ("error", "heaviest_id", "log", "status", "run_id", "road_class", "sumo_config", "loads")
+_FIRST = ("run_id", "status", *AXES, "sumo_seed", "road_seed", "loads_seed", "duration", "steps")
 _LAST = ("vehicles", "max_on_deck", "heaviest_kg", "heaviest_id", "liftoff_events", "liftoff_steps",
          "wall_time", "wall_time_total", "log", "error")
 #: x-axis label of each swept axis in the plots.
@@ -47,6 +47,7 @@ AXIS_LABELS = {
     "vehicles_per_hour": "vehicles per hour per direction",
     "truck_share": "truck share",
     "speed_limit": "speed limit [m/s]",
+    "loads": "vehicles' loads",
     "road_class": "road class",
     "seed": "seed",
 }
@@ -218,6 +219,7 @@ def plot_study(rows: list[dict[str, Any]], study: Study, folder: Path) -> list[P
 
     frame = table_frame(rows)
     ok = frame[frame["status"] == "ok"] if len(frame) else frame
-    ticks = {"sumo_config": {v: study.sumo_label(v) for v in study.axes.get("sumo_config", ())}}
+    ticks = {"sumo_config": {v: study.sumo_label(v) for v in study.axes.get("sumo_config", ())},
+             "loads": {v: study.loads_label(v) for v in study.axes.get("loads", ())}}
     return plot_sweep(ok, study.axes, plotted_statistics(study, ok), folder, title=study.name,
                       axis_labels=AXIS_LABELS, tick_labels=ticks)
