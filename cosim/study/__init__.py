@@ -1,4 +1,4 @@
-"""Traffic-volume studies: a base scenario swept over demand, trucks, speed limit, road and seeds, on Dask.
+"""Traffic-volume studies: a base scenario swept over demand, trucks, speed limit, loads, road and seeds, on Dask.
 
 A study file (TOML, ``docs/studies.md`` documents every key) names a base
 scenario and sweep axes; every combination of axis values is one *run*:
@@ -12,9 +12,11 @@ scenario and sweep axes; every combination of axis values is one *run*:
   share, the light ones to the rest;
 - ``speed_limit``: the speed of every lane of the network (internal junction
   lanes aside), m/s;
+- ``loads``: ``fixed`` (no ``[traffic.loads]``: each vehicle weighs what its
+  vType says) or a WIM site model replacing the base's ``[traffic.loads]`` model;
 - ``road_class``: smooth or an ISO 8608 class;
-- ``seeds``: Monte Carlo repetitions; SUMO's seed and the road-profile seed
-  are both the run's seed.
+- ``seeds``: Monte Carlo repetitions; SUMO's seed, the road-profile seed and
+  the loads' seed are all the run's seed.
 
 For every run cosim writes the SUMO files and the scenario it generated into
 ``<output>/runs/<run id>/``, runs the scenario there into ``run.mcap`` and

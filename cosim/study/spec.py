@@ -9,6 +9,7 @@ sweep's edits (:mod:`cosim.sumo.files`). Nothing here runs anything.
 from __future__ import annotations
 
 import copy
+import difflib
 import hashlib
 import itertools
 import math
@@ -22,6 +23,7 @@ from typing import Annotated, Any
 from pydantic import Field, PlainValidator, Strict, field_validator
 
 from cosim.core.limits import MAX_RUNS
+from cosim.core.loads import bundled_sites, load_model
 from cosim.core.roughness import ISO_CLASSES as ISO_ROAD_CLASSES
 from cosim.errors import ConfigError, CosimError
 from cosim.run.config_base import ConfigModel, Name, Positive, Problems, choice, fail, load_config, show
@@ -47,6 +49,7 @@ __all__ = [
     "AXES",
     "BUNDLED_LEVELS",
     "DEFAULT_PERCENTILES",
+    "FIXED_LOADS",
     "SUMO_AXES",
     "RunTask",
     "Study",
@@ -66,11 +69,14 @@ AXES: dict[str, str] = {
     "vehicles_per_hour": "vph",
     "truck_share": "trucks",
     "speed_limit": "vmax",
+    "loads": "loads",
     "road_class": "road",
     "seed": "seed",
 }
 #: Axes that edit the SUMO demand: the base scenario needs [traffic] (or the sumo_config axis).
-SUMO_AXES = ("sumo_config", "vehicles_per_hour", "truck_share", "speed_limit")
+SUMO_AXES = ("sumo_config", "vehicles_per_hour", "truck_share", "speed_limit", "loads")
+#: The ``loads`` axis's value for a run without ``[traffic.loads]``: every vehicle weighs what its vType says.
+FIXED_LOADS = "fixed"
 #: Bundled demand levels (``sumo_networks/<level>.sumocfg``): the scenario's own list.
 BUNDLED_LEVELS = SUMO_LEVELS
 DEFAULT_PERCENTILES = (50.0, 95.0, 99.0)
@@ -126,6 +132,7 @@ class SweepSection(ConfigModel):
     vehicles_per_hour: tuple[Positive, ...] | None = None
     truck_share: tuple[_Share, ...] | None = None
     speed_limit: tuple[Positive, ...] | None = None
+    loads: tuple[_Text, ...] | None = None
     road_class: tuple[Annotated[str, choice(ROAD_CLASSES, "road class")], ...] | None = None
     seeds: Annotated[tuple[int, ...], PlainValidator(_seeds)] | None = None
 
@@ -265,6 +272,8 @@ class Study:
         for name, value in params.items():
             if name == "sumo_config":
                 text = self.sumo_label(value)
+            elif name == "loads":
+                text = self.loads_label(value)
             elif isinstance(value, str):
                 text = value
             else:
@@ -277,6 +286,16 @@ class Study:
         stem = value if value in BUNDLED_LEVELS else Path(value).name.removesuffix(".sumocfg")
         values = self.axes.get("sumo_config", ())
         stems = [v if v in BUNDLED_LEVELS else Path(v).name.removesuffix(".sumocfg") for v in values]
+        if stems.count(stem) > 1:
+            stem += "-" + hashlib.sha1(value.encode()).hexdigest()[:6]
+        return stem
+
+    def loads_label(self, value: str) -> str:
+        """How run ids and plots name a ``loads`` value: ``fixed``, the site's name or the folder's (plus a hash if
+        ambiguous)."""
+        values = self.axes.get("loads", ())
+        stems = [_loads_stem(v) for v in values]
+        stem = _loads_stem(value)
         if stems.count(stem) > 1:
             stem += "-" + hashlib.sha1(value.encode()).hexdigest()[:6]
         return stem
@@ -372,6 +391,24 @@ class Study:
             traffic["sumo_config"] = f"{SUMO_FOLDER}/{sumo.config}"
             if seed is not None:
                 traffic["seed"] = seed
+            # [traffic.loads]: the loads axis keeps or removes it (and names its model); the seed is the run's
+            loads = traffic.get("loads")
+            if params.get("loads") == FIXED_LOADS:
+                loads = None
+            elif "loads" in params:
+                model, site_files = _site_files(params["loads"], self.study_dir)
+                loads = {**(loads or {}), "model": model}
+                files.update(site_files)
+            elif isinstance(loads, dict):
+                model, site_files = _site_files(str(loads["model"]), self.base_dir)
+                loads = {**loads, "model": model}
+                files.update(site_files)
+            traffic.pop("loads", None)
+            if isinstance(loads, dict):
+                if seed is not None:
+                    loads["seed"] = seed
+                traffic["loads"] = loads
+                seeds["loads_seed"] = loads.get("seed")
             if self.duration is not None:
                 traffic["end"] = float(traffic.get("begin", 0.0)) + self.duration
                 solver = data.get("solver")
@@ -384,6 +421,55 @@ class Study:
         from cosim.run.toml_writer import toml_dumps
 
         return toml_dumps(data), files, seeds
+
+
+def _loads_stem(value: str) -> str:
+    """A ``loads`` value's short name: ``fixed``, a bundled site's name, or a folder's name."""
+    if value == FIXED_LOADS or value.lower() in {site.lower() for site in bundled_sites()}:
+        return value
+    return Path(value).name or value
+
+
+def _site_files(model: str, folder: Path) -> tuple[str, dict[str, bytes]]:
+    """A run's ``[traffic.loads] model`` and the files it needs: a bundled site as it is; a folder of parameter
+    files (relative to ``folder``) copied into the run's ``inputs/loads/<name>/`` (its ``.csv`` files)."""
+    if model.lower() in {site.lower() for site in bundled_sites()}:
+        return model, {}
+    source = Path(model) if Path(model).is_absolute() else folder / model
+    target = f"inputs/loads/{id_part(source.name) or 'site'}"
+    files = {f"{target}/{path.name}": path.read_bytes() for path in sorted(source.iterdir())
+             if path.is_file() and path.suffix.lower() == ".csv"}
+    return target, files
+
+
+def _check_loads(values: tuple[str, ...], base_data: dict[str, Any], base: Scenario, study_dir: Path,
+                 source: str) -> None:
+    """Each ``loads`` value: ``fixed``, or a site or folder that reads, with ``[traffic.loads]`` in the base."""
+    sites = bundled_sites()
+    has_loads = isinstance((base_data.get("traffic") or {}).get("loads"), dict)
+    for i, value in enumerate(values):
+        if value == FIXED_LOADS:
+            continue
+        where = f"{source}: sweep.loads[{i}]"
+        path = Path(value) if Path(value).is_absolute() else study_dir / value
+        if value.lower() not in {site.lower() for site in sites} and not path.is_dir():
+            close = difflib.get_close_matches(value.lower(), [FIXED_LOADS, *(s.lower() for s in sites)], n=1)
+            hint = ""
+            if close:
+                hint = "; did you mean " + (f'"{close[0]}"' if close[0] == FIXED_LOADS else
+                                            f'"{next(s for s in sites if s.lower() == close[0])}"') + "?"
+            raise ConfigError(
+                f"{where}: {value!r} is neither \"{FIXED_LOADS}\" (the vTypes' own weights), a bundled site "
+                f"({', '.join(sites)}) nor a folder of BTLS parameter files (relative to the study file){hint}")
+        if not has_loads:
+            raise ConfigError(
+                f"{where}: {value!r} draws each vehicle's loads, which needs the base scenario's [traffic.loads] "
+                f"(its seed, vtype_classes and wander are kept, the value replaces its model), but {base.source} "
+                f"has none; add one (docs/scenario.md) or sweep only \"{FIXED_LOADS}\"")
+        try:
+            load_model(value, study_dir)
+        except ConfigError as exc:
+            raise ConfigError(f"{where}: {exc}") from None
 
 
 def error_text(exc: BaseException) -> str:
@@ -440,6 +526,8 @@ def parse_study(text: str, source: str = "<study>", base_dir: str | os.PathLike[
                     f"{source}: sweep.{axis}: needs SUMO traffic, but the base scenario {base.source} has "
                     f"{'[[vehicles]]' if base_data.get('vehicles') else 'no [traffic]'}; give a base with "
                     "[traffic] (docs/studies.md)")
+    if "loads" in axes:
+        _check_loads(axes["loads"], base_data, base, study_dir, source)
     sumo_sets: dict[str, SumoSet | ConfigError] = {}
     if has_traffic and "vehicles" not in base_data:
         configs: list[tuple[str, Path, str]] = []

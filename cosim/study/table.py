@@ -20,7 +20,7 @@ import numpy as np
 
 from cosim.core.bridge import BridgeModel
 from cosim.core.quasistatic import daf, quasi_static
-from cosim.core.traffic import FrameTraffic, ScriptedTraffic
+from cosim.core.traffic import FrameTraffic, ScriptedTraffic, vehicle_of
 from cosim.run.scenario import Scenario
 from cosim.study.folder import TABLE_CSV, TABLE_PARQUET, write_file
 from cosim.study.logs import logged_sensors, logged_traffic
@@ -38,8 +38,8 @@ __all__ = [
 ]
 
 #: Columns that hold text; every other column is numeric.
-TEXT_COLUMNS = ("error", "heaviest_id", "log", "status", "run_id", "road_class", "sumo_config")
-_FIRST = ("run_id", "status", *AXES, "sumo_seed", "road_seed", "duration", "steps")
+TEXT_COLUMNS = ("error", "heaviest_id", "log", "status", "run_id", "road_class", "sumo_config", "loads")
+_FIRST = ("run_id", "status", *AXES, "sumo_seed", "road_seed", "loads_seed", "duration", "steps")
 _LAST = ("vehicles", "max_on_deck", "heaviest_kg", "heaviest_id", "liftoff_events", "liftoff_steps",
          "wall_time", "wall_time_total", "log", "error")
 #: x-axis label of each swept axis in the plots.
@@ -48,6 +48,7 @@ AXIS_LABELS = {
     "vehicles_per_hour": "vehicles per hour per direction",
     "truck_share": "truck share",
     "speed_limit": "speed limit [m/s]",
+    "loads": "vehicles' loads",
     "road_class": "road class",
     "seed": "seed",
 }
@@ -106,10 +107,12 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"{name}.rms"] = float(np.sqrt(np.mean(values**2))) if len(values) else None
         row[f"{name}.static_peak"] = qs.peak[name] if qs is not None else None
         row[f"{name}.daf"] = daf(peak, qs.peak[name]) if qs is not None else None
+    # Vehicles, not contact points: a vehicle with its own axles is "id#0", "id#1", ... in result.vehicle_ids.
+    vehicles = len({vehicle_of(contact) for contact in result.vehicle_ids})
     for name, fat in outcome.fatigue.items():
         per_year = fat.damage_per_year
         if vehicles_per_year is not None:
-            per_year = fat.damage * vehicles_per_year / len(result.vehicle_ids) if result.vehicle_ids else None
+            per_year = fat.damage * vehicles_per_year / vehicles if vehicles else None
         row[f"{name}.cycles"] = fat.cycles
         row[f"{name}.damage"] = fat.damage
         row[f"{name}.damage_per_year"] = per_year
@@ -121,7 +124,7 @@ def run_statistics(scenario: Scenario, bridge: Any, outcome: Any, percentiles: S
         row[f"gvw.{cls}.sd"] = w.sd
         row[f"gvw.{cls}.max"] = w.high
     row.update({
-        "vehicles": len(result.vehicle_ids),
+        "vehicles": vehicles,
         "max_on_deck": result.max_on_deck,
         "heaviest_kg": qs.heaviest if qs is not None else None,
         "heaviest_id": qs.heaviest_id if qs is not None else None,
@@ -219,6 +222,7 @@ def plot_study(rows: list[dict[str, Any]], study: Study, folder: Path) -> list[P
 
     frame = table_frame(rows)
     ok = frame[frame["status"] == "ok"] if len(frame) else frame
-    ticks = {"sumo_config": {v: study.sumo_label(v) for v in study.axes.get("sumo_config", ())}}
+    ticks = {"sumo_config": {v: study.sumo_label(v) for v in study.axes.get("sumo_config", ())},
+             "loads": {v: study.loads_label(v) for v in study.axes.get("loads", ())}}
     return plot_sweep(ok, study.axes, plotted_statistics(study, ok), folder, title=study.name,
                       axis_labels=AXIS_LABELS, tick_labels=ticks)

@@ -162,7 +162,8 @@ def test_the_rows_are_the_runs_one_by_one(small_study, tmp_path):
     for name in ("mid", "mid_moment", "mid_acc"):
         assert row[f"{name}.min"] == alone.result.sensor_min[name]
         assert row[f"{name}.max"] == alone.result.sensor_max[name]
-    assert row["vehicles"] == len(alone.result.vehicle_ids)
+    # vehicles, not contact points: a lorry of the bundled mix is "id#0", "id#1", ... in vehicle_ids
+    assert row["vehicles"] == len({contact.split("#")[0] for contact in alone.result.vehicle_ids})
     assert row["max_on_deck"] == alone.result.max_on_deck
     assert row["liftoff_events"] == alone.result.liftoff_events
     assert compare_sensors(folder / "run.mcap", alone.log_path).identical
@@ -412,6 +413,11 @@ def test_study_file_errors_name_the_file_and_the_key(tmp_path):
             "sweep.sumo_config[0]: file not found",
         '[study]\nbase = "paper-double-tee"\n[sweep]\nvehicles_per_hour = [300]\n':
             "sweep.vehicles_per_hour: needs SUMO traffic",
+        '[study]\nbase = "base.toml"\n[sweep]\nloads = ["fixed", "Auxere"]\n':
+            'sweep.loads[1]: \'Auxere\' is neither "fixed" (the vTypes\' own weights), a bundled site',
+        '[study]\nbase = "base.toml"\n[sweep]\nloads = ["fixed", "Auxerre"]\n':
+            "sweep.loads[1]: 'Auxerre' draws each vehicle's loads, which needs the base scenario's [traffic.loads]",
+        '[study]\nbase = "paper-double-tee"\n[sweep]\nloads = ["fixed"]\n': "sweep.loads: needs SUMO traffic",
     }
     for text, expected in cases.items():
         path = tmp_path / "s.toml"
@@ -433,6 +439,44 @@ def test_run_ids_follow_the_values_not_the_order_of_execution(tmp_path):
     assert tasks[2].parameters == {"road_class": "C", "seed": 1, "road_seed": 1}
     assert 'class = "C"\nseed = 1' in tasks[2].scenario_text
     assert "duration = 60.0" in tasks[0].scenario_text  # a scripted base: the study's duration is the run's
+
+
+def test_a_loads_axis_runs_the_base_with_and_without_its_traffic_loads(tmp_path):
+    """``loads = ["fixed", <site>, <folder>]``: no [traffic.loads], or the base's with that model (a folder's
+    files travel with the run); the run's seed is the loads' seed too (the same ids draw anew in every seed)."""
+    from cosim.core.loads import bundled_sites
+
+    site = tmp_path / "my site"
+    site.mkdir()
+    auxerre = Path(cosim.__file__).parent / "core" / "loads" / "sites" / "Auxerre"
+    for name in ("GVWpdf.csv", "ASall.csv", "AW2&3.csv", "AW4&5.csv", "CLASS%.csv"):
+        shutil.copyfile(auxerre / name, site / name)
+    (site / "notes.txt").write_text("not a parameter file")
+    base = BASE.replace("[solver]", '[traffic.loads]\nmodel = "Auxerre"\nseed = 7\nwander = "none"\n'
+                                    'vtype_classes = { artic_loaded = [5] }\n[solver]')
+    path = _write_study(tmp_path, STUDY.replace("vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]",
+                                                'loads = ["fixed", "angers", "my site"]\nseeds = [3, 4]'), base)
+    study = load_study(path, output=tmp_path / "out")
+    tasks = study.tasks()
+    assert [t.run_id for t in tasks] == ["loads-fixed_seed-3", "loads-fixed_seed-4", "loads-angers_seed-3",
+                                         "loads-angers_seed-4", "loads-my_site_seed-3", "loads-my_site_seed-4"]
+    assert tasks[0].parameters == {"loads": "fixed", "seed": 3, "sumo_seed": 3}
+    assert "[traffic.loads]" not in tasks[0].scenario_text
+    assert tasks[3].parameters == {"loads": "angers", "seed": 4, "loads_seed": 4, "sumo_seed": 4}
+    assert '[traffic.loads]\nmodel = "angers"\nseed = 4\nwander = "none"' in tasks[3].scenario_text
+    assert "artic_loaded = [5]" in tasks[3].scenario_text
+    assert not [name for name in tasks[3].files if name.startswith("inputs/")]
+    assert 'model = "inputs/loads/my_site"\nseed = 3' in tasks[4].scenario_text
+    copied = sorted(name for name in tasks[4].files if name.startswith("inputs/"))
+    assert copied == sorted(f"inputs/loads/my_site/{name}" for name in ("GVWpdf.csv", "ASall.csv", "AW2&3.csv",
+                                                                       "AW4&5.csv", "CLASS%.csv"))
+    assert tasks[4].files["inputs/loads/my_site/GVWpdf.csv"] == (site / "GVWpdf.csv").read_bytes()
+    # Without a seeds axis the base's loads seed stays; a site's name in any case is a site.
+    one = load_study(_write_study(tmp_path / "one", STUDY.replace(
+        "vehicles_per_hour = [300.0, 900.0]\nseeds = [1, 2]", 'loads = ["AUXERRE"]'), base), output=tmp_path / "o1")
+    (task,) = one.tasks()
+    assert task.run_id == "loads-AUXERRE" and task.parameters["loads_seed"] == 7
+    assert "auxerre" in {s.lower() for s in bundled_sites()}
 
 
 def test_the_study_command(tmp_path):

@@ -252,3 +252,49 @@ def test_a_site_folder_is_read_as_btls_lays_it_out_names_in_any_case(tmp_path):
     (folder / "ASall.csv").rename(folder / "ASALL.csv")  # as pybtls ships Angers
     model = load_model("site", base=tmp_path)
     assert model.spacings == load_model("Auxerre").spacings and model.name == "site"
+
+
+def test_truncated_moments_are_scipys_truncnorm():
+    """Mixture.moments (the mean wheelbase that fits a class to a vType, and the tests' checks of draws) in closed
+    form: equal to scipy.stats.truncnorm.stats for every mode of every bundled site's parameters (1e-12 of the
+    sd for the mean, 1e-9 relative for the variance), and on a grid of bounds from 8 sd below to 7 above the
+    mean, one side open or both closed."""
+    from cosim.core.loads.mixture import Mode, _truncated_moments
+
+    def check(mode, lower, upper):
+        a, b = (lower - mode.mean) / mode.sd, (upper - mode.mean) / mode.sd
+        mean, var = stats.truncnorm.stats(a, b, loc=mode.mean, scale=mode.sd, moments="mv")
+        got_mean, got_var = _truncated_moments(mode, lower, upper)
+        assert abs(got_mean - mean) <= 1e-12 * mode.sd and got_var == pytest.approx(var, rel=1e-9)
+
+    checked = 0
+    for site in bundled_sites():
+        model = load_model(site)
+        groups = [*model.gvw, *model.spacings, *model.axle_shares, *(m for row in model.group_shares for m in row)]
+        for mixture in (m for group in groups for m in group):
+            for mode, p in zip(mixture.modes, mixture.mode_probabilities()):
+                if mode.sd > 0.0 and p > 0.0:
+                    check(mode, mixture.lower, mixture.upper)
+                    checked += 1
+    assert checked > 300
+    grid = np.linspace(-8.0, 7.0, 31)
+    for a in grid:
+        check(Mode(1.0, 3.0, 2.0), -np.inf, 3.0 + 2.0 * a)
+        check(Mode(1.0, 3.0, 2.0), 3.0 + 2.0 * a, np.inf)
+        for b in grid[grid > a + 0.2]:
+            check(Mode(1.0, 3.0, 2.0), 3.0 + 2.0 * a, 3.0 + 2.0 * b)
+
+
+def test_drawing_loads_does_not_import_scipy_stats():
+    """Importing scipy.stats costs about half a second of CPU (benchmarks/results/loads.md: 3 % of the default
+    run): a run that draws loads does without it (the class fit's mean wheelbase, the truck and car draws)."""
+    import subprocess
+    import sys
+
+    code = ("import sys\nfrom cosim.core.loads import draw_car, load_model, wander\n"
+            "from cosim.sumo.loads import classes_for\nmodel = load_model('Auxerre')\n"
+            "classes_for(model, 16.5, 1.4, (4, 5)), classes_for(model, 10.0, 1.5, (2, 3))\n"
+            "model.draw(1, 'v', 1), model.draw(1, 'w', 2), draw_car(1, 'c'), wander(1, 'c')\n"
+            "print('scipy.stats' in sys.modules)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
