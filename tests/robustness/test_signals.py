@@ -161,7 +161,8 @@ def test_a_killed_export_leaves_neither_csv_nor_temporary_file(tmp_path: Path) -
     log = tmp_path / "big.mcap"
     with LogRecorder(log, ["a", "b"]) as rec:
         times = [k * 0.01 for k in range(60_000)]
-        rec.write_encoded("/cosim/sensors", times, [b'{"t":%r,"a":%r,"b":0.5}' % (t, 1e-3 * t) for t in times])
+        for t in times:
+            rec.write("/cosim/sensors", t, {"t": t, "a": 1e-3 * t, "b": 0.5})
     proc = start("export", str(log), "--csv", "out.csv", cwd=tmp_path)
     wait_for(lambda: any(".part" in p.name for p in tmp_path.iterdir()), 30, 0.0005)
     proc.send_signal(signal.SIGTERM)
