@@ -14,9 +14,11 @@ Two parts:
 - :func:`record_routes`, before SUMO starts (sumolib, through
   :mod:`cosim.sumo.network`; no libsumo): each lane of the lanes table matched
   to a lane of the deck (same direction, its wheel path within the lane) and
-  its way through the network: the lanes followed upstream (the straightest
-  predecessor at each junction) up to :data:`APPROACH` m before the deck or to
-  the network's edge, and downstream at least :data:`EXIT` m past it.
+  its way through the network: the lanes that lead to it followed upstream
+  (the straightest predecessor at each junction) up to :data:`APPROACH` m
+  before the deck, the network's edge, or the first lane that heads against
+  the deck's direction (a lane fed by a turn starts on the road that turns
+  in), and downstream at least :data:`EXIT` m past it.
 - :class:`RecordFeed`, during the run: the file streamed (constant memory, the
   records read :data:`LOOKAHEAD` s ahead of SUMO's clock), each record added to
   SUMO through libsumo (``vehicle.add``), its length set to fit its axles, its
@@ -47,7 +49,7 @@ from cosim.core.traffic import LoadRecord
 from cosim.errors import ConfigError, SumoError, first_line
 
 from .loads import FRONT_OVERHANG, REAR_OVERHANG
-from .network import BridgeAxis, _graph, _is_vehicle_lane, _samples, read_network
+from .network import BridgeAxis, is_vehicle_lane, lane_graph, polyline_samples, read_network
 from .vtypes import VehicleType, loaded_vehicle_type
 
 __all__ = ["APPROACH", "EXIT", "LOOKAHEAD", "MAX_SPEED", "RECORD_VTYPES", "RecordFeed", "RecordRoute",
@@ -187,9 +189,9 @@ def deck_lanes(net_file: str | Path, axis: BridgeAxis, y_range: tuple[float, flo
     found = []
     for edge in net.getEdges(withInternal=False):
         for lane in edge.getLanes():
-            if not _is_vehicle_lane(lane):
+            if not is_vehicle_lane(lane):
                 continue
-            pts = _samples(lane.getShape())
+            pts = polyline_samples(lane.getShape())
             x, y = axis.project(pts[:, 0], pts[:, 1])
             over = (x > 0.0) & (x < axis.length) & (y >= lo) & (y <= hi)
             if not over.any():
@@ -234,9 +236,12 @@ def _heading(shape: Any, last: bool) -> np.ndarray:
 
 
 def _walk(net: Any, start: str, graph: dict[str, list[str]], length: dict[str, float], limit: float,
-          upstream: bool) -> list[str]:
-    """Lanes from ``start`` (excluded) along ``graph`` (predecessors upstream, successors downstream), the
-    straightest at each branch, until ``limit`` m are covered or the network ends."""
+          along: np.ndarray | None = None) -> list[str]:
+    """Lanes from ``start`` (excluded) along ``graph``, the straightest at each branch, until ``limit`` m are
+    covered or the network ends. Upstream (``graph`` the predecessors, ``along`` the way the deck's lane drives):
+    also up to the first lane that heads against ``along`` (the road that turns in; farther back, a loop around
+    a block would lead round to it); returned upstream first."""
+    upstream = along is not None
     out: list[str] = []
     seen = {start}
     current, covered = start, 0.0
@@ -250,15 +255,19 @@ def _walk(net: Any, start: str, graph: dict[str, list[str]], length: dict[str, f
         seen.add(current)
         out.append(current)
         covered += length.get(current, 0.0)
+        if along is not None:
+            shape = np.asarray(net.getLane(current).getShape(), dtype=float)[:, :2]
+            if float(np.dot(shape[-1] - shape[0], along)) < 0.0:
+                break
     return out[::-1] if upstream else out
 
 
 def _route(net: Any, axis: BridgeAxis, lane: RecordLane, deck: DeckLaneLine) -> RecordRoute:
-    succ, pred, length = _graph(net)
-    before = _walk(net, deck.id, pred, length, APPROACH, upstream=True)
+    succ, pred, length = lane_graph(net)
+    before = _walk(net, deck.id, pred, length, APPROACH, lane.direction * axis.unit()[0])
     while before and net.getLane(before[0]).getEdge().getFunction() == "internal":
         before.pop(0)  # a vehicle departs on a normal edge
-    after = _walk(net, deck.id, succ, length, EXIT + axis.length, upstream=False)
+    after = _walk(net, deck.id, succ, length, EXIT + axis.length)
     chain = [*before, deck.id, *after]
     while net.getLane(chain[-1]).getEdge().getFunction() == "internal":
         chain.pop()  # and arrives on one
