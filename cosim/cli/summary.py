@@ -158,7 +158,7 @@ def _records_line(scenario: Scenario) -> str:
     else:
         how = ("each inserted into SUMO upstream of the deck to reach it at its recorded time (if undisturbed), lane "
                "and speed, as long as its axles, each a tyre quarter-car of its recorded load on cosim's library "
-               "suspension of its vClass (SUMO's cosim.records.car, .truck or .trailer vType)")
+               "suspension of its vClass (SUMO's vType cosim-records-car, -truck or -trailer)")
         clock = "SUMO's clock"
     wander = "no wander" if records.wander == "none" else (
         f"wander {records.wander}" if isinstance(records.wander, str) else f"wander sd {fmt_g(records.wander)} m") + (

@@ -73,9 +73,9 @@ MAX_SPEED = 70.0
 #: truck, one of 4 or more an articulated lorry (SUMO's ``trailer``). Their drivers do not dawdle (sigma 0) and
 #: keep their speed factor (speedDev 0): a record's speed is known.
 RECORD_VTYPES: dict[str, tuple[str, str, tuple[float, float, float, float, float, float]]] = {
-    "car": ("cosim.records.car", "passenger", (5.0, 2.5, 2.6, 4.5, 9.0, 1.8)),
-    "truck": ("cosim.records.truck", "truck", (7.1, 2.5, 1.3, 4.0, 7.0, 2.4)),
-    "trailer": ("cosim.records.trailer", "trailer", (16.5, 2.5, 1.1, 4.0, 7.0, 2.55)),
+    "car": ("cosim-records-car", "passenger", (5.0, 2.5, 2.6, 4.5, 9.0, 1.8)),
+    "truck": ("cosim-records-truck", "truck", (7.1, 2.5, 1.3, 4.0, 7.0, 2.4)),
+    "trailer": ("cosim-records-trailer", "trailer", (16.5, 2.5, 1.1, 4.0, 7.0, 2.55)),
 }
 
 
@@ -147,7 +147,7 @@ class RecordRoute:
 
     def route_id(self, k: int) -> str:
         """The SUMO route from edge ``k`` on."""
-        return f"cosim.records.lane{self.lane}.{k}"
+        return f"cosim-records-lane{self.lane}-{k}"
 
     def start_for(self, target: float, tau: float, factor: float) -> float | None:
         """Where (m along the route) a vehicle must be to reach ``target`` in ``tau`` s (``tau`` < 0: to have
