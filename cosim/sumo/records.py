@@ -437,7 +437,7 @@ class RecordFeed:
             raise SumoError(f"{self.plan.path}: line {record.line}: lane {record.lane} has no route")
         length, front = vehicle_length(record)
         factor = record.speed / route.entry_limit
-        where = self._departure(route, record.time, factor, front, now)
+        where = self.departure(route, record.time, factor, front, now)
         if where is None:  # its first axle past the route's end already (read after its time): not in this run
             self.skipped += 1
             return None
@@ -462,15 +462,15 @@ class RecordFeed:
         self.longest = max(self.longest, length)
         return vehicle
 
-    def _departure(self, route: RecordRoute, time: float, factor: float, front: float,
-                   now: float) -> tuple[float, int, float] | None:
+    def departure(self, route: RecordRoute, time: float, factor: float, front: float,
+                  now: float) -> tuple[float, int, float] | None:
         """(SUMO depart time on the step grid, index of the lane, position on it) that brings the first axle to
         the deck's entry end at ``time`` undisturbed: a vehicle added with depart ``d`` stands at its departure
         position at SUMO's time ``d + step`` (libsumo's clock after the step that inserts it)."""
         target = route.entry + front  # the bumper's position when the first axle is at the entry
         grid = self.step
         # From the route's start, on the step grid (rounded up: the start itself or a little after it).
-        depart = self.begin + math.ceil((time - grid - _travel(route, 0.0, target, factor) - self.begin) / grid
+        depart = self.begin + math.ceil((time - grid - travel_time(route, 0.0, target, factor) - self.begin) / grid
                                         - 1e-9) * grid
         depart = max(depart, now)
         starts = route.starts
@@ -502,7 +502,7 @@ class RecordFeed:
             self.live.pop(vid, None)
 
 
-def _travel(route: RecordRoute, p: float, q: float, factor: float) -> float:
+def travel_time(route: RecordRoute, p: float, q: float, factor: float) -> float:
     """Seconds from ``p`` to ``q`` (m along the route, ``p <= q``) at ``factor`` times each lane's limit."""
     total, starts = 0.0, route.starts
     for start, length, limit in zip(starts, route.lengths, route.limits):
