@@ -197,6 +197,19 @@ def test_an_undisturbed_record_reaches_the_deck_at_its_time_a_held_back_one_late
         assert loads[vid]["t"] == pytest.approx(first["t"])
 
 
+def test_sumo_in_its_own_process_inserts_the_same_records(run: dict) -> None:
+    """Without a log, SUMO steps in a child process (cosim.run.sumo_process): the records are inserted there, and
+    the deck's mid-span deflection is the logged run's (SUMO in the run's process), bit for bit."""
+    from cosim.run.simulate import simulate_scenario
+
+    scenario = load_scenario(run["folder"] / "wim.toml")
+    result = simulate_scenario(scenario)
+    logged = run["log"].topic("/cosim/sensors")
+    assert len(result.t) == len(logged)
+    assert [float(v) for v in result.sensors["mid"]] == [m["mid"] for m in logged]
+    assert min(m["mid"] for m in logged) < -1e-3  # the records loaded it (a mm and more)
+
+
 def test_the_records_are_read_a_lookahead_ahead_of_sumo(tmp_path: Path) -> None:
     """The file is streamed: after each SUMO step to time t, exactly the records due by t + LOOKAHEAD have been
     added (reference: the record times as written, here 15 s apart over 5 minutes), the later ones not yet read;
