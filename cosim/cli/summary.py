@@ -148,19 +148,24 @@ def _records_line(scenario: Scenario) -> str:
     counts = dict(check.per_lane)
     lanes = ", ".join(f"{lane.lane} (y = {lane.y:+.3f} m, {lane.direction}, {counts.get(lane.lane, 0)} records)"
                       for lane in records.lanes)
-    window = ("the whole file" if records.begin == 0 and records.end is None else
-              f"{fmt_g(records.begin)} s to " + (f"{fmt_g(records.end)} s" if records.end is not None else "its end"))
+    begin, end = scenario.records_window
+    window = ("the whole file" if begin == 0 and end == float("inf") else
+              f"{fmt_g(begin)} s to " + (f"{fmt_g(end)} s" if end != float("inf") else "its end"))
     if records.via == "scripted":
         axles = ("moving forces" if records.axle_model == "moving-force" else
                  "tyre quarter-cars on cosim's library suspensions")
         how = f"each driven at its recorded time, lane and speed (no SUMO), its axles {axles}"
+        clock = f"t = 0 at {fmt_g(records.begin)} s"
     else:
-        how = "each inserted into SUMO upstream of the deck to reach it at its recorded time, lane and speed"
+        how = ("each inserted into SUMO upstream of the deck to reach it at its recorded time (if undisturbed), lane "
+               "and speed, as long as its axles, each a tyre quarter-car of its recorded load on cosim's library "
+               "suspension of its vClass (SUMO's vType cosim-records-car, -truck or -trailer)")
+        clock = "SUMO's clock"
     wander = "no wander" if records.wander == "none" else (
         f"wander {records.wander}" if isinstance(records.wander, str) else f"wander sd {fmt_g(records.wander)} m") + (
         f", seed {records.seed}" if records.seed is not None else "")
     return (f"Records: {check.path} ({records.format}), {check.count} of its {summary.count} records in {window} "
-            f"(times from midnight of {summary.origin.isoformat()}; t = 0 at {fmt_g(records.begin)} s), lanes "
+            f"(times from midnight of {summary.origin.isoformat()}; {clock}), lanes "
             f"{lanes}; {how}; {wander}")
 
 

@@ -9,16 +9,24 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 from cosim.core.loads import VehicleRecord
 from cosim.core.records_traffic import LIGHT_WEIGHT, RecordLane, moving_forces
 from cosim.core.vehicles import VehicleModel
+from cosim.errors import ConfigError
 from cosim.sumo.library import GOLDEN_CAR, ROAD_FRIENDLY
+from cosim.sumo.network import BridgeAxis
+from cosim.sumo.records import RecordsPlan, record_routes
 from cosim.sumo.vtypes import LOADS_G, library_model
 
 from .tables import DIRECTIONS, RecordsConfig
 
-__all__ = ["axle_models", "record_lanes"]
+if TYPE_CHECKING:
+    from .scenario import Scenario
+
+__all__ = ["axle_models", "record_lanes", "records_plan"]
 
 
 def record_lanes(records: RecordsConfig) -> tuple[RecordLane, ...]:
@@ -43,3 +51,26 @@ def _quarter_cars(record: VehicleRecord) -> tuple[VehicleModel, ...]:
 def _quarter_car(load: float, light: bool) -> VehicleModel:
     """An axle of ``load`` N (the formats' loads are whole units: a few hundred values)."""
     return library_model(GOLDEN_CAR if light else ROAD_FRIENDLY, load / LOADS_G)
+
+
+def records_plan(scenario: Scenario, net: Path, axis: BridgeAxis) -> RecordsPlan:
+    """``[traffic.records]`` with ``via = "sumo"`` for the SUMO run on ``net`` with the bridge on ``axis``: the file
+    read and checked (:meth:`Scenario.records_check`) and each lane of the lanes table given its route through
+    the network (:func:`cosim.sumo.records.record_routes`), before SUMO starts.
+
+    Raises:
+        ConfigError: a bad record (naming the file and the line), a lane the table does not map, a lane of the
+            table that lies on no lane of the network's deck in its direction (naming the key).
+    """
+    records = scenario.records
+    assert records is not None and records.via == "sumo"
+    check = scenario.records_check()
+    try:
+        routes = record_routes(net, axis, record_lanes(records), scenario.bridge.section.deck_y,
+                               key="traffic.records.lanes")
+    except ConfigError as exc:
+        raise ConfigError(f"{scenario.source}: {exc}") from None
+    begin, end = scenario.records_window
+    return RecordsPlan(path=check.path, format=records.format, lanes_per_direction=check.lanes_per_direction,
+                       begin=begin, end=end, routes=routes, wander=records.wander,
+                       seed=records.seed if records.seed is not None else 0)

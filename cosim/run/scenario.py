@@ -475,9 +475,25 @@ class Scenario(ConfigModel):
         records = self.records
         return None if records is None else Path(self._base_dir) / records.file
 
+    @property
+    def records_window(self) -> tuple[float, float]:
+        """The records that run, ``begin <= time < end`` (s from midnight of the file's first day): ``[traffic.records]
+        begin`` and ``end``; with ``via = "sumo"`` also within SUMO's ``[traffic] begin`` and ``end`` (SUMO's clock
+        is the records').
+
+        Raises:
+            ConfigError: the scenario has no ``[traffic.records]``.
+        """
+        records, traffic = self.records, self.traffic
+        if records is None or traffic is None:
+            raise ConfigError(f"{self._source}: the scenario has no [traffic.records]")
+        if records.via == "sumo":
+            return max(records.begin, traffic.begin), min(records.window_end, traffic.end)
+        return records.begin, records.window_end
+
     def records_check(self) -> RecordsCheck:
         """``[traffic.records]``'s file read and checked once (every line; the lanes mapped by its lanes table,
-        times never going backwards; what its window holds), before anything is written
+        times never going backwards; what its window, :attr:`records_window`, holds), before anything is written
         (:func:`cosim.core.records_traffic.check_records`); the same answer afterwards.
 
         Raises:
@@ -488,12 +504,16 @@ class Scenario(ConfigModel):
         records, path = self.records, self.records_path
         if records is None or path is None:
             raise ConfigError(f"{self._source}: the scenario has no [traffic.records]")
-        check = check_records(path, records.format, record_lanes(records), self.bridge.length, records.begin,
-                              records.window_end, key="traffic.records.lanes")
+        begin, end = self.records_window
+        check = check_records(path, records.format, record_lanes(records), self.bridge.length, begin, end,
+                              key="traffic.records.lanes")
         if check.count == 0:
             summary = check.summary
             window = f"begin = {number_text(records.begin)} s" + (
                 f" to end = {number_text(records.window_end)} s" if records.end is not None else " on")
+            if records.via == "sumo" and self.traffic is not None:
+                window += (f", within SUMO's [traffic] begin = {number_text(self.traffic.begin)} s to "
+                           f"end = {number_text(self.traffic.end)} s")
             raise ConfigError(f"{self._source}: traffic.records: no record of {path} lies in the window, {window} "
                               f"(its {summary.count} records run from {number_text(summary.first)} to "
                               f"{number_text(summary.last)} s after midnight of its first day, "

@@ -163,9 +163,14 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
             where = f"{entry.file}: " if entry is not None else ""
             raise ConfigError(f"{scenario.source}: traffic.sumo_config: {where}{exc}") from None
     loads = _load_settings(scenario, demand) if t.loads is not None else None
+    records = None
+    if t.records is not None:  # via = "sumo": the file checked and each lane's route found before SUMO starts
+        from .records import records_plan
+
+        records = records_plan(scenario, net, axis)
     with scenario.named("traffic"):
         settings = SumoSettings(config, axis, step=t.step, begin=t.begin, end=t.end, edges=t.edges or None,
-                                seed=t.seed, deck_y=deck_y, demand=demand, loads=loads)
+                                seed=t.seed, deck_y=deck_y, demand=demand, loads=loads, records=records)
     return SumoPlan(config=config, net=net, axis=axis, axis_from=axis_from, location=location, deck_y=deck_y,
                     demand=demand, types=tuple(types), settings=settings)
 

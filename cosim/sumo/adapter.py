@@ -38,7 +38,7 @@ import shutil
 import sys
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
@@ -53,6 +53,7 @@ from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.loads import LoadSettings, VehicleLoads
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
+from cosim.sumo.records import RecordFeed, RecordsPlan
 from cosim.sumo.vtypes import LOADS_G, VehicleType, vehicle_type
 
 __all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeAxis", "LiveSumo", "SumoSettings",
@@ -133,6 +134,8 @@ class SumoSettings:
         extra_args: further SUMO command-line options.
         demand: the config's demand files as read (:func:`cosim.sumo.files.read_demand`), if already read.
         loads: each vehicle's own loads from a WIM-calibrated model (``[traffic.loads]``), or None: the vTypes'.
+        records: WIM records inserted into the network (``[traffic.records] via = "sumo"``,
+            :mod:`cosim.sumo.records`), or None.
 
     Raises:
         SumoError, ConfigError: a config that is not there, a step or times that are not physical.
@@ -149,6 +152,7 @@ class SumoSettings:
     extra_args: tuple[str, ...] = ()
     demand: Demand | None = None
     loads: LoadSettings | None = None
+    records: RecordsPlan | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "config", Path(self.config))
@@ -327,6 +331,7 @@ class SumoTraffic(LiveSumo):
         self._axles: dict[str, tuple[tuple[float, float], ...]] = {}  # per contact: behind the bumper, left, m
         self._sideways: set[str] = set()  # the types with a contact point beside the path (left != 0)
         self._draws = VehicleLoads(settings.loads) if settings.loads is not None else None
+        self._feed = RecordFeed(settings.records, settings.step, settings.begin) if settings.records else None
         self._own: dict[str, VehicleType] = {}  # a vehicle with its own loads -> its vehicle type
         self._label: dict[str, tuple[str, float, str]] = {}  # vehicle -> its class, wander (m), loads' source
         self._recorded: set[str] = set()  # vehicles whose load record went out (at their entry onto the deck)
@@ -379,11 +384,15 @@ class SumoTraffic(LiveSumo):
             raise SumoError(f"{self.config}: SUMO could not load it: {reason}") from None
         try:
             self._watch()
+            if self._feed is not None:
+                self._feed.define_types(libsumo)
             # Every vType known at the start is turned into its vehicle model now, so that an
             # impossible parameter stops the run before it starts, naming the vType.
             for type_id in libsumo.vehicletype.getIDList():
                 if type_id not in self.demand.distributions and type_id not in _BUILT_IN_OTHER:
                     self._model(type_id)
+            if self._feed is not None:
+                self._feed.start(self.types)
             self._extend_reach()
             self._trails = AxleTrails(self.reach)
         except Exception:
@@ -395,6 +404,8 @@ class SumoTraffic(LiveSumo):
 
     def _close_sumo(self) -> bool:
         was_running = self.libsumo is not None or self._scratch is not None
+        if self._feed is not None:
+            self._feed.close()
         if self.libsumo is not None:
             try:
                 with _captured_output(self._scratch / "console.txt") if self._scratch else contextlib.nullcontext():
@@ -495,7 +506,8 @@ class SumoTraffic(LiveSumo):
 
     def _extend_reach(self) -> None:
         """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
-        longest = max((t.length for t in self.types.values()), default=0.0)
+        longest = max(max((t.length for t in self.types.values()), default=0.0),
+                      self._feed.longest if self._feed is not None else 0.0)
         wanted = max(WATCH_MARGIN, longest + REACH_SLACK)
         if wanted > self.reach + 1e-9 or not self.lanes:
             self.reach = wanted
@@ -530,9 +542,15 @@ class SumoTraffic(LiveSumo):
     def advance(self) -> Frame:
         """One SUMO step; returns the frame of vehicles near the bridge."""
         ls = self.libsumo
+        feed = self._feed
+        if feed is not None and feed.insert(ls, ls.simulation.getTime()) and \
+                feed.longest + REACH_SLACK > self.reach + 1e-9:
+            self._extend_reach()  # a record longer than any vehicle so far: watch farther
         try:
             ls.simulationStep()
             self.teleports += ls.simulation.getStartingTeleportNumber()
+            if feed is not None and feed.live:
+                feed.gone(ls.simulation.getArrivedIDList())
         except Exception as exc:  # noqa: BLE001 - SUMO errors come as several libsumo exception types
             raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {first_line(exc)}") \
                 from None
@@ -562,6 +580,9 @@ class SumoTraffic(LiveSumo):
         rows = [results[vid] for vid in ids]
         P, H, S, A, T = tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE
         vtypes = [r[T] for r in rows]
+        if feed is not None and feed.live:  # a record's SUMO type is its own (its length): modelled as its vType's
+            live = feed.live
+            vtypes = [live[vid].base if vid in live else typ for vid, typ in zip(ids, vtypes)]
         for typ in dict.fromkeys(vtypes):
             if typ not in self.types:
                 self._model(typ)
@@ -602,7 +623,7 @@ class SumoTraffic(LiveSumo):
             heading = np.radians(num[:, 2])
             ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
             y = y + ahead[owner] * left
-        if self._draws is not None:  # each vehicle's wander within its lane
+        if self._draws is not None or feed is not None:  # each vehicle's wander within its lane
             offsets = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in vehicles])
             y = y + offsets[owner]
         loads = self._entering(vehicles, vehicle_types, num, owner, x, y)
@@ -617,22 +638,31 @@ class SumoTraffic(LiveSumo):
     # ----------------------------------------------------------------- loads
     def _first_sight(self, vid: str, vtype: str, row: np.ndarray) -> None:
         """A vehicle seen for the first time: with ``[traffic.loads]``, what it carries (its own vehicle type,
-        class, wander and the loads' source), drawn from the seed and its id; its direction from its heading."""
+        class, wander and the loads' source), drawn from the seed and its id; its direction from its heading.
+        A WIM record inserted into SUMO carries its recorded axles (:mod:`cosim.sumo.records`)."""
+        record = self._feed.live.get(vid) if self._feed is not None else None
+        if record is not None:
+            self._own_type(vid, record.vehicle_type)
+            self._label[vid] = (record.load.vehicle_class, record.wander, record.load.source)
+            return
         if self._draws is None:
             return
         heading = np.radians(row[2])
         along = self._unit[0]
         direction = 1 if math.sin(heading) * along[0] + math.cos(heading) * along[1] >= 0.0 else 2
         draw = self._draws.draw(vid, self.types[vtype], direction)
-        own = draw.vehicle_type
-        if own is not None:
-            columns = own.contact_columns()
-            self._axles[own.id] = tuple((back, left) for _, _, back, left in columns)
-            if any(left for _, left in self._axles[own.id]):
-                self._sideways.add(own.id)
-            self._known({key: model for key, model, _, _ in columns})
-            self._own[vid] = own
+        if draw.vehicle_type is not None:
+            self._own_type(vid, draw.vehicle_type)
         self._label[vid] = (draw.vehicle_class, draw.wander, draw.source)
+
+    def _own_type(self, vid: str, own: VehicleType) -> None:
+        """A vehicle with a vehicle type of its own (its own axles and loads)."""
+        columns = own.contact_columns()
+        self._axles[own.id] = tuple((back, left) for _, _, back, left in columns)
+        if any(left for _, left in self._axles[own.id]):
+            self._sideways.add(own.id)
+        self._known({key: model for key, model, _, _ in columns})
+        self._own[vid] = own
 
     def _entering(self, vehicles: list[str], types: list[str], num: np.ndarray, owner: np.ndarray, x: np.ndarray,
                   y: np.ndarray) -> tuple[LoadRecord, ...]:
@@ -654,9 +684,13 @@ class SumoTraffic(LiveSumo):
                 lane = str(self.libsumo.vehicle.getLaneID(vid))
             except Exception:  # noqa: BLE001 - no lane to be had: the record says so
                 lane = ""
+            first = int(np.flatnonzero(owner == r)[0])
+            record = self._feed.live.get(vid) if self._feed is not None else None
+            if record is not None:  # a WIM record: its recorded loads, as recorded
+                out.append(replace(record.load, lane=lane, speed=float(num[r, 3]), y=float(y[first])))
+                continue
             weight = vtype.mass * LOADS_G
             distances = [d for d, _ in vtype.axles]
-            first = int(np.flatnonzero(owner == r)[0])
             out.append(LoadRecord(id=vid, vehicle_class=label, lane=lane, speed=float(num[r, 3]), gvw=weight,
                                   axle_loads=tuple(share * weight for _, share in vtype.axles),
                                   axle_spacings=tuple(b - a for a, b in zip(distances, distances[1:])),

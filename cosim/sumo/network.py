@@ -58,8 +58,11 @@ __all__ = [
     "DeckLane",
     "bridge_candidates",
     "edge_options",
-    "wheel_paths_beyond",
+    "is_vehicle_lane",
+    "lane_graph",
     "lanes_across",
+    "polyline_samples",
+    "wheel_paths_beyond",
     "locate_bridge",
     "net_path",
     "read_network",
@@ -160,7 +163,7 @@ def _read_network(path: str, size: int, mtime_ns: int) -> Any:
 # --------------------------------------------------------------------------- lanes
 
 
-def _samples(shape: Any, step: float = SAMPLE_STEP) -> np.ndarray:
+def polyline_samples(shape: Any, step: float = SAMPLE_STEP) -> np.ndarray:
     """Points along a polyline at most ``step`` apart (its vertices included), (n, 2)."""
     pts = np.asarray(shape, dtype=float)[:, :2]
     out = [pts[:1]]
@@ -171,14 +174,14 @@ def _samples(shape: Any, step: float = SAMPLE_STEP) -> np.ndarray:
     return np.concatenate(out)
 
 
-def _is_vehicle_lane(lane: Any) -> bool:
+def is_vehicle_lane(lane: Any) -> bool:
     """True unless only pedestrians may use the lane (a sidewalk is not part of the carriageway)."""
     allowed = set(lane.getPermissions())
     return bool(allowed - {"pedestrian"})
 
 
 @functools.lru_cache(maxsize=4)
-def _graph(net: Any) -> tuple[dict[str, list[str]], dict[str, list[str]], dict[str, float]]:
+def lane_graph(net: Any) -> tuple[dict[str, list[str]], dict[str, list[str]], dict[str, float]]:
     """Successors and predecessors of every lane (internal junction lanes included), and lane lengths."""
     succ: dict[str, list[str]] = {}
     pred: dict[str, list[str]] = {}
@@ -302,8 +305,8 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
     net = read_network(net_file)
     known = [e.getID() for e in net.getEdges()]
     found = [_edge_or_error(net, net_file, e, known) for e in edges]
-    lanes = [(edge, lane) for edge in found for lane in edge.getLanes() if _is_vehicle_lane(lane)]
-    footways = [(edge, lane) for edge in found for lane in edge.getLanes() if not _is_vehicle_lane(lane)]
+    lanes = [(edge, lane) for edge in found for lane in edge.getLanes() if is_vehicle_lane(lane)]
+    footways = [(edge, lane) for edge in found for lane in edge.getLanes() if not is_vehicle_lane(lane)]
     if not lanes:
         raise ConfigError(f"edge(s) {', '.join(edges)} of {net_file.name} have no lane for vehicles")
     # Direction: the first named edge's lanes, first point to last.
@@ -317,7 +320,7 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
     centre_lines = {}
 
     def row(edge: Any, lane: Any) -> tuple[Any, Any, float, float, int, float, float]:
-        pts = _samples(lane.getShape()) - origin
+        pts = polyline_samples(lane.getShape()) - origin
         along, across = pts @ e_dir, pts @ n_dir
         centre_lines[lane.getID()] = (along, across)
         lane_chord = np.subtract(lane.getShape()[-1][:2], lane.getShape()[0][:2])
@@ -392,9 +395,9 @@ def lanes_across(net_file: str | Path, axis: BridgeAxis, y_range: tuple[float, f
     lo, hi = y_range
     for edge in net.getEdges(withInternal=True):
         for lane in edge.getLanes():
-            if not _is_vehicle_lane(lane):
+            if not is_vehicle_lane(lane):
                 continue
-            pts = _samples(lane.getShape())
+            pts = polyline_samples(lane.getShape())
             x, y = axis.project(pts[:, 0], pts[:, 1])
             if np.any((x > 0.0) & (x < axis.length) & (y >= lo) & (y <= hi)):
                 found.append(lane.getID())
@@ -414,7 +417,7 @@ def watched_lanes(net_file: str | Path, deck_lanes: Iterable[str], reach: float,
     ``upstream`` reach lets the frames see a vehicle a step before it enters.
     """
     net = read_network(net_file)
-    succ, pred, length = _graph(net)
+    succ, pred, length = lane_graph(net)
     deck = list(dict.fromkeys(deck_lanes))
     found = dict.fromkeys(deck)
     for graph, limit in ((succ, reach), (pred, upstream)):
@@ -497,7 +500,7 @@ def bridge_candidates(net_file: str | Path, near: tuple[float, float] | None = N
     for edge in sorted(net.getEdges(), key=lambda e: e.getID()):
         if edge.getID() in seen or edge.getFunction() not in ("", "normal"):
             continue
-        lanes = [lane for lane in edge.getLanes() if _is_vehicle_lane(lane)]
+        lanes = [lane for lane in edge.getLanes() if is_vehicle_lane(lane)]
         if not lanes:
             continue
         pair = [edge] + [o for o in _opposite(net, edge) if o.getID() not in seen][:1]
@@ -505,11 +508,11 @@ def bridge_candidates(net_file: str | Path, near: tuple[float, float] | None = N
         length = max(float(e.getLength()) for e in pair)
         if length < min_length:
             continue
-        pts = _samples(edge.getShape())
+        pts = polyline_samples(edge.getShape())
         mid = pts[len(pts) // 2]
         out.append(BridgeCandidate(
             edges=tuple(e.getID() for e in pair), length=length,
-            lanes=tuple(sum(1 for lane in e.getLanes() if _is_vehicle_lane(lane)) for e in pair),
+            lanes=tuple(sum(1 for lane in e.getLanes() if is_vehicle_lane(lane)) for e in pair),
             names=tuple(dict.fromkeys(n for n in (e.getName() for e in pair) if n)),
             osm_bridge=tuple(dict.fromkeys(v for v in (_osm_bridge(e) for e in pair) if v)),
             middle=(float(mid[0]), float(mid[1])),
@@ -531,6 +534,6 @@ def lane_shapes(net_file: str | Path, around: tuple[float, float], radius: float
     for edge in net.getEdges(withInternal=True):
         for lane in edge.getLanes():
             pts = np.asarray(lane.getShape(), dtype=float)[:, :2]
-            if np.min(np.hypot(*(_samples(pts) - np.asarray(around)).T)) <= radius:
+            if np.min(np.hypot(*(polyline_samples(pts) - np.asarray(around)).T)) <= radius:
                 out.append((lane.getID(), pts))
     return out
