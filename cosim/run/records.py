@@ -66,7 +66,7 @@ def records_plan(scenario: Scenario, net: Path, axis: BridgeAxis) -> RecordsPlan
     assert records is not None and records.via == "sumo"
     check = scenario.records_check()
     try:
-        routes = record_routes(net, axis, record_lanes(records), scenario.bridge.section.deck_y,
+        routes = record_routes(net, axis, record_lanes(records), scenario.bridge.deck_y,
                                key="traffic.records.lanes")
     except ConfigError as exc:
         raise ConfigError(f"{scenario.source}: {exc}") from None
