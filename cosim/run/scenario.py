@@ -52,8 +52,7 @@ from pydantic import (
 )
 
 from cosim.core.bridge import DOF_NAMES, SUPPORT_PRESETS, BridgeModel, build_bridge
-from cosim.core.modal_bridge import ModalBridge, place_deck
-from cosim.core.modal_deck import ModalDeck
+from cosim.core.modal_bridge import ModalBridge
 from cosim.core.records_traffic import RecordsCheck, RecordTraffic, check_records
 from cosim.core.roughness import (
     RoadProfile,
@@ -87,6 +86,7 @@ from .config_base import (
     show,
     suggest,
 )
+from .deck_placement import place_on_network
 from .records import axle_models, record_lanes
 from .tables import (
     QUANTITIES,
@@ -248,7 +248,8 @@ class Scenario(ConfigModel):
             raise fail('a deck given by its modes runs with method = "dynamic" (the quasi-static method uses the '
                        "beam model's influence lines)", "solver", "method")
         if bridge.frame == "network":
-            deck, axis = self._placed(deck, Path(base))
+            assert self.traffic is not None
+            deck, axis = place_on_network(deck, self.traffic, self.sumo_config_path_in(Path(base)))
             bridge.keep_axis(axis)
         bridge.keep_deck(deck)
         try:  # the deck is in the bridge frame now, wherever its points were given
@@ -261,34 +262,6 @@ class Scenario(ConfigModel):
             except ConfigError as exc:
                 raise fail(str(exc), "sensors", i) from None
         return self
-
-    def _placed(self, deck: ModalDeck, base: Path) -> tuple[ModalDeck, tuple[tuple[float, float],
-                                                                               tuple[float, float]]]:
-        """A network-frame deck moved into the bridge frame (docs/modal-decks.md#frames): the bridge runs along
-        ``[traffic] axis`` (its direction), else along the lanes of ``[traffic] edges``; x = 0 at the deck's first
-        point along it. Returns the deck and the axis in network coordinates, from x = 0 to the deck's end."""
-        traffic = self.traffic
-        assert traffic is not None
-        if traffic.axis is not None:
-            start, end = (np.asarray(p, dtype=float) for p in traffic.axis)
-        elif traffic.edges:
-            from cosim.sumo.network import locate_bridge, net_path
-
-            config = self.sumo_config_path_in(base)
-            try:
-                located = locate_bridge(net_path(config), traffic.edges).axis
-            except ConfigError as exc:
-                raise fail(str(exc), "traffic", "edges") from None
-            start, end = np.asarray(located.start, dtype=float), np.asarray(located.end, dtype=float)
-        else:
-            raise fail('frame = "network" needs the bridge\'s direction: give [traffic] edges (the deck\'s edges) '
-                       "or axis", "bridge", "frame")
-        along = (end - start) / float(np.linalg.norm(end - start))
-        x = (deck.points[:, 0] - start[0]) * along[0] + (deck.points[:, 1] - start[1]) * along[1]
-        origin = start + float(x.min()) * along
-        placed = place_deck(deck, (float(origin[0]), float(origin[1])), (float(along[0]), float(along[1])))
-        far = origin + float(np.ptp(x)) * along
-        return placed, ((float(origin[0]), float(origin[1])), (float(far[0]), float(far[1])))
 
     def sumo_config_path_in(self, base: Path) -> Path:
         """``[traffic] sumo_config`` resolved (a bundled level, or a file relative to ``base``)."""
