@@ -210,6 +210,13 @@ def test_sumo_in_its_own_process_inserts_the_same_records(run: dict) -> None:
     assert min(m["mid"] for m in logged) < -1e-3  # the records loaded it (a mm and more)
 
 
+def test_the_log_replays_the_records_bit_for_bit(run: dict) -> None:
+    """A replay takes the frames and each record's axle models from the log alone (SUMO is not run again)."""
+    result = cosim_cli("replay", "run.mcap", "--out", "replay.mcap", cwd=run["folder"])
+    assert result.returncode == 0, result.stderr
+    assert "identical, bit for bit" in result.stdout, result.stdout
+
+
 def test_the_records_are_read_a_lookahead_ahead_of_sumo(tmp_path: Path) -> None:
     """The file is streamed: after each SUMO step to time t, exactly the records due by t + LOOKAHEAD have been
     added (reference: the record times as written, here 15 s apart over 5 minutes), the later ones not yet read;
