@@ -7,11 +7,13 @@ The deck is moved into that bridge frame (a rotation and a shift:
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from cosim.core.modal_bridge import place_deck
+from cosim.core.modal_bridge import ModalBridge, place_deck
 from cosim.core.modal_deck import ModalDeck
 from cosim.errors import ConfigError
 
@@ -53,3 +55,28 @@ def place_on_network(deck: ModalDeck, traffic: TrafficConfig, config: Path | Non
     placed = place_deck(deck, (float(origin[0]), float(origin[1])), (float(along[0]), float(along[1])))
     far = origin + float(np.ptp(x)) * along
     return placed, ((float(origin[0]), float(origin[1])), (float(far[0]), float(far[1])))
+
+
+def check_lanes_covered(bridge: ModalBridge, net: Path, lanes: Sequence[Any], axis: Any, where: str) -> None:
+    """Every vehicle lane of ``[traffic] edges`` lies on the deck's surface over the deck's length (its centre
+    line, the wheel path, sampled every metre), or one line names the lane and where it leaves the surface.
+
+    Args:
+        bridge: the deck given by its modes, in the bridge frame of ``axis``.
+        net: the SUMO network; lanes: the edges' vehicle lanes (:class:`cosim.sumo.network.DeckLane`).
+        axis: the bridge axis in network coordinates (:class:`cosim.sumo.network.BridgeAxis`).
+        where: the scenario's source, for the message.
+    """
+    from cosim.sumo.network import polyline_samples, read_network
+
+    network = read_network(net)
+    for lane in lanes:
+        x, y = axis.project(*polyline_samples(network.getLane(lane.id).getShape(), 1.0).T)
+        inside = (x > 0.0) & (x < bridge.length)
+        off = np.flatnonzero(inside & ~bridge.covers(x, y))
+        if len(off):
+            i = int(off[0])
+            raise ConfigError(f"{where}: traffic.edges: lane {lane.id} leaves the deck's surface at x = {x[i]:.2f} m, "
+                              f"y = {y[i]:.2f} m (bridge frame): the points of {bridge.source or 'the modes file'} "
+                              "do not cover it; give points (or triangles) that cover every vehicle lane of the "
+                              "edges")

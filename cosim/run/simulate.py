@@ -31,6 +31,7 @@ from cosim.core.simulation import SimulationResult, simulate
 from cosim.core.traffic import FrameSink, TrafficSource
 from cosim.errors import ConfigError, ModelError, SumoError
 
+from .deck_placement import check_lanes_covered
 from .scenario import Scenario
 
 if TYPE_CHECKING:
@@ -143,6 +144,8 @@ def plan_sumo(scenario: Scenario) -> SumoPlan:
                 "covered: cosim models no pedestrians)")
     else:
         axis, axis_from = BridgeAxis((0.0, 0.0), (length, 0.0)), "the default (0, 0) -> (L, 0)"
+    if location is not None and scenario.bridge.is_modal:  # the mode surface, not a width, says where the deck is
+        check_lanes_covered(scenario.build_modal_bridge(), net, location.lanes, axis, scenario.source)
     if location is None:
         with scenario.named("traffic"):
             if not lanes_across(net, axis, deck_y):

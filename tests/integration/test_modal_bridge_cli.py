@@ -214,25 +214,50 @@ dt = 0.005
 """
 
 
-def test_a_network_frame_deck_is_placed_where_its_points_are(tmp_path: Path) -> None:
-    """frame = "network": the beam's modes, their points moved to where the bridge lies in a network turned by
-    30 degrees, give the run of the same modes in the bridge frame (placement: a rotation and a shift, exact
-    to round-off; 1e-9 of the peak), with real SUMO traffic both ways."""
+def _rotated_network(folder: Path):  # noqa: ANN202 - a BridgeAxis
+    """The turned two-way road built with SUMO's netconvert, its routes and config; the deck edges' axis."""
     import subprocess
 
     import sumo
 
     from cosim.sumo.network import locate_bridge
 
-    (tmp_path / "rot.nod.xml").write_text(ROTATED_NODES)
-    (tmp_path / "rot.edg.xml").write_text(ROTATED_EDGES)
+    (folder / "rot.nod.xml").write_text(ROTATED_NODES)
+    (folder / "rot.edg.xml").write_text(ROTATED_EDGES)
     subprocess.run([str(Path(sumo.SUMO_HOME) / "bin" / "netconvert"), "--node-files", "rot.nod.xml",
                     "--edge-files", "rot.edg.xml", "-o", "rot.net.xml", "--offset.disable-normalization", "true",
-                    "--no-turnarounds", "true", "--no-warnings", "true"], cwd=tmp_path, check=True,
+                    "--no-turnarounds", "true", "--no-warnings", "true"], cwd=folder, check=True,
                    capture_output=True, timeout=60)
-    (tmp_path / "rot.rou.xml").write_text(ROTATED_ROUTES)
-    (tmp_path / "rot.sumocfg").write_text(ROTATED_CONFIG)
-    axis = locate_bridge(tmp_path / "rot.net.xml", ["deck", "-deck"]).axis
+    (folder / "rot.rou.xml").write_text(ROTATED_ROUTES)
+    (folder / "rot.sumocfg").write_text(ROTATED_CONFIG)
+    return locate_bridge(folder / "rot.net.xml", ["deck", "-deck"]).axis
+
+
+def test_points_that_leave_a_lane_uncovered_are_one_line_naming_the_lane(tmp_path: Path) -> None:
+    """A network-frame deck 2 m wide under lanes 3.5 m wide on each side of the axis (issue 26, item 8)."""
+    axis = _rotated_network(tmp_path)
+    beam = testing.scenario({"bridge": testing.bridge(axis.length, elements_per_span=12, deck_y=(-1.0, 1.0)),
+                             "solver": {"duration": 1.0}}).build_beam()
+    deck = from_beam(beam, n_modes=6, lateral=3)
+    e, n = axis.unit()
+    network = deck.points[:, :1] * e + deck.points[:, 1:] * n + np.asarray(axis.start)
+    np.savez(tmp_path / "narrow.npz", x=network[:, 0], y=network[:, 1], f_hz=deck.f_hz, phi=deck.phi)
+    (tmp_path / "narrow.toml").write_text('name = "narrow"\n[bridge]\nmodes = "narrow.npz"\nframe = "network"\n'
+                                          + ROTATED_TRAFFIC)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    result = cosim_cli("run", "narrow.toml", "--out", "run.mcap", cwd=tmp_path)
+    assert result.returncode == 2, result.stderr
+    line = result.stderr.strip()
+    assert "\n" not in line and line.startswith("cosim: error: narrow.toml: traffic.edges: lane "), line
+    assert "leaves the deck's surface" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_a_network_frame_deck_is_placed_where_its_points_are(tmp_path: Path) -> None:
+    """frame = "network": the beam's modes, their points moved to where the bridge lies in a network turned by
+    30 degrees, give the run of the same modes in the bridge frame (placement: a rotation and a shift, exact
+    to round-off; 1e-9 of the peak), with real SUMO traffic both ways."""
+    axis = _rotated_network(tmp_path)
     length = axis.length
     beam = testing.scenario({"bridge": testing.bridge(length, elements_per_span=12, deck_y=(-4.0, 4.0)),
                              "solver": {"duration": 1.0}}).build_beam()
