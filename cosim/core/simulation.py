@@ -145,7 +145,9 @@ class SimulationResult:
         factorizations: effective-matrix factorisations done (counted by the basis; 1 per run).
         steps: time steps taken; wall_time: s.
         sensor_min, sensor_max: extremes per sensor over every step (not only the samples).
-        contact_force_range: (min, max) contact force per vehicle while on the deck, N.
+        contact_force_range: (min, max) contact force per vehicle while on the deck, N (a run of more than
+            :data:`MAX_FORCE_RANGES` contact points keeps those with the largest forces and those that pulled:
+            constant memory over a year of records).
         max_on_deck: most vehicles on the deck at once (a vehicle's axles count once).
         weights: gross-weight statistics per vehicle class of the vehicles that came onto the deck (from their
             load records: ``/cosim/vehicle_loads``).
@@ -232,6 +234,11 @@ class _Collector:
             self.table[name].append(values[name])
 
 
+#: A run keeps the contact-force ranges of at most about this many contact points (twice it between prunes):
+#: those with the largest forces, those that pulled, those on the deck (:attr:`SimulationResult.contact_force_range`).
+MAX_FORCE_RANGES = 20_000
+
+
 class _Extremes:
     """Running extremes for summaries, in constant memory whatever the run's length."""
 
@@ -262,6 +269,15 @@ class _Extremes:
             lo_hi = self.force.setdefault(report.ids[j], [np.inf, -np.inf])
             lo_hi[0] = min(lo_hi[0], float(f_min[j]))
             lo_hi[1] = max(lo_hi[1], float(f_max[j]))
+        if len(self.force) > 2 * MAX_FORCE_RANGES:
+            self._prune(set(report.ids))
+
+    def _prune(self, current: set[str]) -> None:
+        """Keep the force ranges a summary shows: the contact points still in the fleet, those that pulled
+        (min < 0) and the :data:`MAX_FORCE_RANGES` with the largest force; a year of records has millions of
+        axles, and their ranges (about 200 bytes each) were the run's only memory that grew with its length."""
+        ranked = sorted(self.force.items(), key=lambda item: item[1][1], reverse=True)
+        self.force = {k: v for i, (k, v) in enumerate(ranked) if i < MAX_FORCE_RANGES or v[0] < 0 or k in current}
 
 
 @compiled(nogil=True)

@@ -26,3 +26,34 @@ def test_block_extremes_equal_numpys_masked_reductions(seed: int) -> None:
     assert np.array_equal(f_max, np.where(on_deck, force, -np.inf).max(axis=0, initial=-np.inf))
     vehicles_on = [len({int(col_owner[j]) for j in np.flatnonzero(row)}) for row in on_deck]
     assert most == (max(vehicles_on) if q else 0)
+
+
+def test_the_force_ranges_of_a_long_run_stay_bounded_and_keep_what_a_summary_shows(monkeypatch) -> None:
+    """A stream of vehicles (a year of records has millions of axles): the ranges kept stay under twice the bound,
+    and the heaviest, every one that pulled and the fleet on the deck now are all there with their exact ranges
+    (reference: every range kept, computed without the bound)."""
+    from cosim.core import simulation
+    from cosim.core.coupling import BlockReport
+
+    monkeypatch.setattr(simulation, "MAX_FORCE_RANGES", 50)
+    extremes = simulation._Extremes([])
+    everything: dict[str, tuple[float, float]] = {}
+    rng = np.random.default_rng(3)
+    for block in range(400):
+        ids = (f"v{block}#0", f"v{block}#1")
+        force = rng.uniform(1e4, 9e4, size=(10, 2))
+        if block % 97 == 0:
+            force[3, 1] = -100.0  # a wheel that pulled
+        on = np.ones((10, 2), dtype=bool)
+        zeros = np.zeros((10, 2))
+        report = BlockReport(ids, (), zeros, np.zeros(2), zeros, zeros, on, force, zeros, zeros, np.zeros((10, 0)),
+                             np.zeros((10, 2), dtype=bool))
+        extremes.on_block(np.arange(10) * 0.01, np.ones(10, dtype=bool), report)
+        for j, vid in enumerate(ids):
+            everything[vid] = (float(force[:, j].min()), float(force[:, j].max()))
+        assert len(extremes.force) <= 2 * 50 + 2
+    heaviest = sorted(everything, key=lambda k: everything[k][1], reverse=True)[:50]
+    pulled = [k for k, (lo, _) in everything.items() if lo < 0]
+    assert len(pulled) == 5
+    for vid in heaviest + pulled + ["v399#0", "v399#1"]:
+        assert tuple(extremes.force[vid]) == everything[vid], vid
