@@ -491,8 +491,8 @@ class CoupledSystem:
         self.t += K * self.dt
         self.n_steps += K
         return BlockReport(block.ids, block.models, block.x, block.y, block.v, block.a, out.on, out.contact,
-                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block), block.loads,
-                           kin.path[:, :, 0] if len(kin.path) else None)
+                           out.body_u, out.body_a, out.sensors, out.lifted, self._beside_surface(block, out.on),
+                           block.loads, kin.path[:, :, 0] if len(kin.path) else None)
 
     def _path(self, block: TrafficBlock) -> tuple[np.ndarray, ...]:
         """The block's per-step paths for a deck given by its modes (a beam reads each wheel's ``y``)."""
@@ -500,28 +500,21 @@ class CoupledSystem:
             return ()
         return (np.ascontiguousarray(block.path, dtype=float),)
 
-    def _beside_surface(self, block: TrafficBlock) -> npt.NDArray[np.bool_]:
+    def _beside_surface(self, block: TrafficBlock, on: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
         """The block's steps at which a wheel was over the deck's length but beside its surface (it loaded
-        nothing then), counted: an event each time a wheel goes there, and every such wheel-step."""
-        K, q = block.x.shape
-        lateral = np.broadcast_to(block.y, block.x.shape) if block.path is None else block.path[:, :, 0]
-        if isinstance(self.bridge, ModalBridge):  # the surface's edge may depend on x (skewed, curved decks)
-            over = kernels.on_deck(block.x, self.bridge.length)
-            covered = self.bridge.covers(block.x, lateral)
-            beside = (over & ~covered).any(axis=0)
-        else:
-            beside = ~self.on_surface(block.y)
-        off = np.zeros((K, q), dtype=bool)
+        nothing then), counted: an event each time a wheel goes there, and every such wheel-step. Where the
+        surface is was decided once, by the compiled step (``on``: on the length and the surface), for a beam's
+        width and a mode surface alike."""
+        off = kernels.on_deck(block.x, self.bridge.length) & ~on
+        beside = off.any(axis=0)
         if beside.any():
             cols = np.flatnonzero(beside)
-            off[:, cols] = kernels.on_deck(block.x[:, cols], self.bridge.length)
-            if isinstance(self.bridge, ModalBridge):
-                off[:, cols] &= ~self.bridge.covers(block.x[:, cols], lateral[:, cols])
             self.offdeck_steps += int(off.sum())
             before = np.array([self._off.get(block.ids[j], False) for j in cols])
             went = np.diff(np.vstack([before[None, :], off[:, cols]]).astype(np.int8), axis=0) > 0
             self.offdeck_events += int(went.sum())
-        self._off = {block.ids[j]: bool(off[-1, j]) for j in np.flatnonzero(beside)} if K else self._off
+        if len(off):
+            self._off = {block.ids[j]: True for j in np.flatnonzero(off[-1])}
         return off
 
     def step(self, frame: TrafficFrame) -> BlockReport:
