@@ -46,7 +46,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS
     os.environ.setdefault(_var, "1")
 
 HERE = Path(__file__).resolve().parent
-RUNS = ("sumo", "direct", "direct+log", "direct+log/thread", "direct+log/no-scene", "modal", "modal+log",
+RUNS = ("libsumo", "sumo", "direct", "direct+log", "direct+log/thread", "direct+log/no-scene", "modal", "modal+log",
         "modal+log/no-scene", "direct+log@1ms")
 DEFAULT_OUT = HERE / "results" / "day.md"
 
@@ -62,7 +62,19 @@ scenario, bridge = default_run(mode, hours)  # kernels compiled, 20 s of the tra
 from cosim.core.simulation import simulate
 out = {"log_bytes": 0}
 started = time.perf_counter()
-if mode == "sumo":
+if mode == "libsumo":  # the baseline of issue 27: SUMO's own loop over the same config, nothing read from it
+    import libsumo
+    from cosim.run.simulate import plan_sumo
+    from cosim.sumo.adapter import sumo_binary
+    s = plan_sumo(scenario).settings
+    libsumo.start([sumo_binary(), "-c", str(s.config), "--step-length", repr(s.step), "--begin", repr(s.begin),
+                   "--end", repr(s.end), "--step-method.ballistic", "true", "--no-step-log", "true",
+                   "--no-warnings", "true", *(["--seed", str(s.seed)] if s.seed is not None else []),
+                   *s.extra_args])
+    for _ in range(int(round(duration / s.step))):
+        libsumo.simulationStep()
+    libsumo.close()
+elif mode == "sumo":
     from cosim.run.simulate import build_traffic
     with build_traffic(scenario, process=False) as traffic:  # SUMO and the adapter, in this process
         for _ in range(int(round(duration / scenario.traffic.step))):

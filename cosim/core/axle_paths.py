@@ -146,14 +146,20 @@ class AxleTrails:
         return np.array([self.slot_of[v] for v in vehicles], dtype=np.int64)
 
 
-@compiled
 def record_fronts(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, step: float) -> None:
     """Append every vehicle's bumper (``vehicles`` rows: x, y (m), heading, speed (m/s), ...) to its trail, one
     traffic step (``step``, s) after the last: the distance driven since the last point is the bumper's move,
     at most the travel of the mean speed over the step (a lane change's sideways jump adds nothing; on a
     curve it is the chord). The newest point is always the bumper; it replaces the newest kept point while
     that lies less than :data:`MIN_SPACING` after the one before it."""
-    px, py, s, head, count, speed = trails
+    # The arrays go in one by one: numba types a named tuple argument in Python at every call (about 50 us,
+    # most of the adapter's step), an array in C.
+    _record_fronts(vehicles, slots, *trails, step)
+
+
+@compiled
+def _record_fronts(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
+                   head: np.ndarray, count: np.ndarray, speed: np.ndarray, step: float) -> None:
     cap = px.shape[1]
     for r in range(vehicles.shape[0]):
         k = slots[r]
@@ -174,7 +180,6 @@ def record_fronts(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, 
         px[k, h], py[k, h], s[k, h], speed[k] = x, y, s_new, v
 
 
-@compiled
 def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, back: np.ndarray, owner: np.ndarray,
                   axis: AxisFrame, y_range: tuple[float, float], x_range: tuple[float, float],
                   span: tuple[float, float, float]
@@ -199,6 +204,17 @@ def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, 
     """
     px, py, s, head, count, _ = trails
     origin, along, left = axis
+    return _axles_on_path(vehicles, slots, px, py, s, head, count, back, owner, origin, along, left,  # as above
+                          float(y_range[0]), float(y_range[1]), float(x_range[0]), float(x_range[1]),
+                          float(span[0]), float(span[1]), float(span[2]))
+
+
+@compiled
+def _axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
+                   head: np.ndarray, count: np.ndarray, back: np.ndarray, owner: np.ndarray, origin: np.ndarray,
+                   along: np.ndarray, left: np.ndarray, y_lo: float, y_hi: float, x_lo: float, x_hi: float,
+                   span_lo: float, span_hi: float, margin: float
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     m = len(back)
     cap = px.shape[1]
     x, y, v, a = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
@@ -254,8 +270,8 @@ def axles_on_path(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, 
         ahead = tx * along[0] + ty * along[1]
         v[i] = vehicles[r, 3] * ahead
         a[i] = vehicles[r, 4] * ahead
-        in_box = y_range[0] <= y[i] <= y_range[1] and x_range[0] <= x[i] <= x_range[1]
-        beside = span[0] <= x[i] <= span[1] and y_range[0] - span[2] <= y[i] <= y_range[1] + span[2]
+        in_box = y_lo <= y[i] <= y_hi and x_lo <= x[i] <= x_hi
+        beside = span_lo <= x[i] <= span_hi and y_lo - margin <= y[i] <= y_hi + margin
         if in_box or beside:
             kept_vehicle[r] = True
     for i in range(m):

@@ -3,9 +3,9 @@
 SUMO runs at its own step. The adapter watches the lanes on which a vehicle
 can have an axle on the deck (:func:`cosim.sumo.network.watched_lanes`: the
 deck's lanes, the junction lanes at its ends and the lanes before and after,
-as far as the longest vehicle reaches) and reads, through subscriptions (no
-per-vehicle getter calls in the loop), each vehicle on them: position (front
-bumper), heading, speed, acceleration and type. A vehicle is followed by
+as far as the longest vehicle reaches) and reads each vehicle on them at every
+step: position (front bumper), heading, speed and acceleration; its type and
+length once, when first seen (libsumo's getters: its subscriptions cost more). A vehicle is followed by
 position, not by the edge it is on: it stays in the frames while it crosses
 the junction at a deck end, so each of its axles is on the deck from the
 moment it passes one end until it passes the other. Each vehicle becomes one
@@ -66,7 +66,7 @@ MESSAGES_FILE = "sumo-messages.log"
 #: The log's attachment with the vehicle types of the run (model, mass, axles and their sources).
 VEHICLE_TYPES_ATTACHMENT = "vehicle-types.json"
 _EMPTY = np.zeros(0)
-#: SUMO steps between two looks for vehicles driving away beyond the watched reach (unsubscribed then).
+#: SUMO steps between two looks for vehicles driving away beyond the watched reach (no longer read then).
 DROP_DEPARTED_EVERY = 20
 #: For a bridge placed by its axis alone, wheels this far beside the deck's width (m, a lane's width) over its
 #: length stay in the frames (and the lanes there are watched): a vehicle on a lane the deck does not cover is
@@ -341,6 +341,7 @@ class SumoTraffic(LiveSumo):
         self._scratch: Path | None = None
         self._watched: set[str] = set()
         self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
+        self._fixed: dict[str, tuple[str, float]] = {}  # each followed vehicle's SUMO type and length, m
 
     @property
     def half_width(self) -> float:
@@ -481,23 +482,15 @@ class SumoTraffic(LiveSumo):
                 f"{self.axis.start} -> {self.axis.end}; check [traffic] axis or edges"
             )
         self.deck_lanes = tuple(deck)
-        ls = self.libsumo
-        tc = ls.constants
-        self._vars = [tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE,
-                      tc.VAR_LENGTH]
-        self._subscribed_lanes: set[str] = set()
-        self._subscribe_lanes(net)
+        self._watched_lanes: set[str] = set()
+        self._watch_lanes(net)
 
-    def _subscribe_lanes(self, net: Path) -> None:
-        """Watch the lanes within :attr:`reach` of the deck (edge context subscriptions miss vehicles at some
-        steps, cf. eclipse-sumo/sumo#16422: each watched lane reports its vehicle list instead)."""
-        ls = self.libsumo
-        lanes = watched_lanes(net, self.deck_lanes, self.reach)
-        for lane in lanes:
-            if lane not in self._subscribed_lanes:
-                ls.lane.subscribe(lane, [ls.constants.LAST_STEP_VEHICLE_ID_LIST])
-                self._subscribed_lanes.add(lane)
-        self.lanes = tuple(self._subscribed_lanes)
+    def _watch_lanes(self, net: Path) -> None:
+        """Watch the lanes within :attr:`reach` of the deck: each is asked for its vehicles at every step (edge
+        context subscriptions miss vehicles at some steps, cf. eclipse-sumo/sumo#16422; and libsumo's
+        subscriptions cost more inside each step than the getters they replace: benchmarks/results/profile.md)."""
+        self._watched_lanes.update(watched_lanes(net, self.deck_lanes, self.reach))
+        self.lanes = tuple(self._watched_lanes)
 
     @property
     def _x_range(self) -> tuple[float, float]:
@@ -511,7 +504,7 @@ class SumoTraffic(LiveSumo):
         wanted = max(WATCH_MARGIN, longest + REACH_SLACK)
         if wanted > self.reach + 1e-9 or not self.lanes:
             self.reach = wanted
-            self._subscribe_lanes(net_path(self.config))
+            self._watch_lanes(net_path(self.config))
             if self._trails is not None:
                 self._trails.ensure_reach(self.reach)
 
@@ -556,30 +549,26 @@ class SumoTraffic(LiveSumo):
                 from None
         self.sumo_steps += 1
         t = self.sumo_steps * self.step
-        tc = ls.constants
+        on_lane = ls.lane.getLastStepVehicleIDs
         present: set[str] = set()
-        for result in ls.lane.getAllSubscriptionResults().values():
-            present.update(result[tc.LAST_STEP_VEHICLE_ID_LIST])
+        for lane in self.lanes:
+            present.update(on_lane(lane))
         self._done &= present  # a vehicle that left the watched lanes is forgotten
         present -= self._done
-        for vid in present - self._watched:
-            ls.vehicle.subscribe(vid, self._vars)
+        veh = ls.vehicle
+        fixed = self._fixed
+        for vid in present - self._watched:  # what does not change while it drives: read once
+            fixed[vid] = (veh.getTypeID(vid), veh.getLength(vid))
         trails = self._trails
         assert trails is not None
         for vid in self._watched - present:
             self._forget(vid)
-            try:
-                ls.vehicle.unsubscribe(vid)
-            except Exception:  # noqa: BLE001 - it arrived or was teleported away: nothing to undo
-                pass
         self._watched = present
         if not present:
             return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
-        results = ls.vehicle.getAllSubscriptionResults()
-        ids = sorted(vid for vid in present if vid in results)
-        rows = [results[vid] for vid in ids]
-        P, H, S, A, T = tc.VAR_POSITION, tc.VAR_ANGLE, tc.VAR_SPEED, tc.VAR_ACCELERATION, tc.VAR_TYPE
-        vtypes = [r[T] for r in rows]
+        ids = sorted(present)
+        position, angle, speed, acceleration = veh.getPosition, veh.getAngle, veh.getSpeed, veh.getAcceleration
+        vtypes = [fixed[vid][0] for vid in ids]
         if feed is not None and feed.live:  # a record's SUMO type is its own (its length): modelled as its vType's
             live = feed.live
             vtypes = [live[vid].base if vid in live else typ for vid, typ in zip(ids, vtypes)]
@@ -589,7 +578,8 @@ class SumoTraffic(LiveSumo):
                 self._extend_reach()  # a longer vehicle than any known so far: watch farther
         # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
         # it drove (cosim.core.axle_paths).
-        num = np.array([(r[P][0], r[P][1], r[H], r[S], r[A], r[tc.VAR_LENGTH]) for r in rows], dtype=float)
+        num = np.array([(*position(vid), angle(vid), speed(vid), acceleration(vid), fixed[vid][1]) for vid in ids],
+                       dtype=float)
         for j, vid in enumerate(ids):
             if vid not in trails.slot_of:
                 trails.add(vid)
@@ -601,7 +591,7 @@ class SumoTraffic(LiveSumo):
         record_fronts(num, slots, trails.arrays, self.step)
         vehicles, vehicle_types = ids, types
         if all(len(self._axles[typ]) == 1 for typ in types):
-            owner = np.arange(len(rows))
+            owner = np.arange(len(ids))
             back = 0.5 * num[:, 5]
         else:
             owner = np.array([i for i, typ in enumerate(types) for _ in self._axles[typ]], dtype=np.int64)
@@ -628,7 +618,7 @@ class SumoTraffic(LiveSumo):
             y = y + offsets[owner]
         loads = self._entering(vehicles, vehicle_types, num, owner, x, y)
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
-            self._drop_departed(vehicles, num)          # drop only keeps a far vehicle subscribed a while longer
+            self._drop_departed(vehicles, num)          # drop only reads a far vehicle a while longer
         if not keep.all():
             ids = [i for i, k in zip(ids, keep) if k]
             types = [ty for ty, k in zip(types, keep) if k]
@@ -707,6 +697,7 @@ class SumoTraffic(LiveSumo):
             self._sideways.discard(own.id)
         self._label.pop(vid, None)
         self._recorded.discard(vid)
+        self._fixed.pop(vid, None)
 
     def _seed_trail(self, vid: str, row: np.ndarray) -> None:
         """A vehicle seen for the first time: its trail starts with its lane behind its bumper (a vehicle
@@ -731,7 +722,7 @@ class SumoTraffic(LiveSumo):
         """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
 
         They are still on a watched lane (a long lane after the deck) but can no longer reach it: they are
-        unsubscribed now, not at every step until they leave the lane. ``num`` rows: x, y, angle, ...,
+        no longer read, not at every step until they leave the lane. ``num`` rows: x, y, angle, ...,
         length (network coordinates, the front bumper).
         """
         heading = np.radians(num[:, 2])
@@ -747,7 +738,3 @@ class SumoTraffic(LiveSumo):
             self._done.add(vid)
             self._watched.discard(vid)
             self._forget(vid)
-            try:
-                self.libsumo.vehicle.unsubscribe(vid)
-            except Exception:  # noqa: BLE001 - nothing to undo
-                pass
