@@ -33,9 +33,6 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
-from scipy.interpolate import BSpline, CubicSpline
-from scipy.spatial import cKDTree
 
 from cosim.errors import ConfigError
 
@@ -117,6 +114,8 @@ def _candidate_axes(points: Array) -> list[Array]:
     _, _, vt = np.linalg.svd(centred, full_matrices=False)
     major = _unit(vt[0])
     axes = [major, _unit(np.array([-major[1], major[0]]))]
+    from scipy.spatial import cKDTree  # here, not at import: a beam's run never loads it (start-up)
+
     _, idx = cKDTree(points).query(points[0], k=2)
     edge = points[int(idx[1])] - points[0]
     if math.hypot(*edge) > 0:
@@ -155,6 +154,8 @@ def tensor_grid(s: Array, r: Array, tol: float) -> tuple[Array, Array, npt.NDArr
 # ------------------------------------------------------------------------------------------- building
 def _spline_slopes(knots: Array, values: Array) -> Array:
     """d/dknot of the not-a-knot cubic spline through ``values`` (axis 0) at the knots (a line for 2 knots)."""
+    from scipy.interpolate import CubicSpline  # here, not at import (start-up)
+
     return np.ascontiguousarray(CubicSpline(knots, values, axis=0, bc_type="not-a-knot").derivative()(knots))
 
 
@@ -263,6 +264,11 @@ def _fitted(points: Array, frame: str, axis: Array, origin: Array, phi: Array, h
     """Scattered points: the least-squares bicubic spline of their values, with knots every
     :data:`KNOTS_PER_SPACING` point spacings and a light curvature penalty (it fills the knot cells the
     points leave empty, beyond their hull, smoothly), written at its knots (docs/theory.md §13.4)."""
+    # Here, not at import: a beam's run never loads them (0.3 s of every start).
+    import scipy.sparse.linalg as spla
+    from scipy.interpolate import BSpline
+    from scipy.spatial import cKDTree
+
     s, r = local_coordinates(points[:, 0], points[:, 1], origin, axis)
     local = np.column_stack([s, r])
     distance, _ = cKDTree(local).query(local, k=2)

@@ -9,6 +9,7 @@ loop would run. So the cache of a core function is keyed on the whole
 """
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable
 from pathlib import Path
@@ -19,6 +20,7 @@ from numba import njit
 CORE = Path(__file__).resolve().parent
 
 
+@functools.cache  # once per process: numba asks for it per compiled function (49 folder walks, 0.2 s a start)
 def _core_stamp() -> tuple[tuple[str, int, int], ...]:
     files = sorted(CORE.rglob("*.py"))
     return tuple((str(p.relative_to(CORE)), p.stat().st_mtime_ns, p.stat().st_size) for p in files)

@@ -27,7 +27,6 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial import Delaunay, QhullError
 
 from cosim.errors import ConfigError
 
@@ -198,6 +197,8 @@ class ModalDeck:
             return triangle_index(self.points, self.triangles)
         if self._interpolation[2]:
             return None
+        from scipy.spatial import Delaunay, QhullError  # here, not at import: a beam's run never loads it
+
         try:
             hull = Delaunay(self.points)
         except QhullError:  # build_grid has refused points on a line already

@@ -33,7 +33,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from cosim.core.bridge import BridgeModel, PointLoad
 from cosim.core.sensors import Sensor, sensor_row
@@ -302,6 +301,8 @@ class SceneWriter:
         self.first = first_column
         self.paths: list[float] = list(plan.paths)
         stations = np.array(plan.stations)
+        from scipy.interpolate import CubicSpline  # here: in the log writer's process, not at every start
+
         # The spline through the stations is linear in their values: a matrix per set of points drawn.
         self._basis = CubicSpline(stations, np.eye(len(stations)), bc_type="natural")
         self.draw_x = np.unique(np.concatenate([np.linspace(a, b, DRAW_SUBDIVISIONS + 1)
