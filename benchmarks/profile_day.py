@@ -19,11 +19,8 @@ Each part is timed with the CPU time of its own thread (`time.thread_time`)
 around the functions named in the table, wrapped before the run starts, so
 that the forked children (the log writer, SUMO's process) inherit the wrappers
 and report their own parts when they end (the report counts the wrapped
-calls: each costs about 2 µs here). Then, in this process: `--hours` of the
-sensors topic encoded as the log writes it (JSON, a message per sample) and as
-fixed binary rows (what a binary encoding such as CDR would cost), each
-compressed with zstd as the log's chunks are: an estimate of what binary
-columns would save, since they are not written.
+calls: each costs about 2 µs here). The log's encodings themselves are
+compared in bench_encoding.py.
 
 This instruments private functions of cosim on purpose (it is a profile); a
 renamed function fails the script with its name.
@@ -38,7 +35,6 @@ import platform
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from _report import write_report  # benchmarks/ is on sys.path when a script runs
@@ -222,47 +218,6 @@ def parts_of(result: dict) -> dict[str, dict[str, float]]:
     return out
 
 
-def encoding_estimate(hours: float) -> list[str]:
-    """The sensors topic of ``hours`` (6 sensors at 100 Hz): JSON as the log writes it vs fixed binary rows."""
-    import numpy as np
-    import zstandard
-
-    from cosim.log.writer import _number_tokens
-
-    steps, sensors = int(round(360_000 * hours)), 6
-    rng = np.random.default_rng(0)
-    times = np.arange(steps) * 0.01
-    values = np.cumsum(rng.normal(size=(steps, sensors)), axis=0) * 1e-5  # smooth, as responses are
-    template = b'{"t":%s' + b"".join(b',"sensor%d":%%s' % i for i in range(sensors)) + b"}"
-    width = sensors + 1
-
-    def as_json() -> list[bytes]:
-        out: list[bytes] = []
-        for lo in range(0, steps, 100):  # the writer gets blocks of about 100 steps
-            tokens = _number_tokens(np.column_stack([times[lo:lo + 100], values[lo:lo + 100]]))
-            out += [template % tuple(tokens[i:i + width]) for i in range(0, len(tokens), width)]
-        return out
-
-    def as_binary() -> list[bytes]:
-        out: list[bytes] = []
-        head, size = b"\x00\x01\x00\x00", 8 * width  # CDR's little-endian header, then the doubles
-        for lo in range(0, steps, 100):
-            raw = np.column_stack([times[lo:lo + 100], values[lo:lo + 100]]).astype("<f8").tobytes()
-            out += [head + raw[i:i + size] for i in range(0, len(raw), size)]
-        return out
-
-    lines = ["| encoding | encode CPU [s] | zstd CPU [s] | bytes [MB] | compressed [MB] |", "|---|---|---|---|---|"]
-    for name, encode in (("JSON, as the log writes it", as_json), ("fixed binary rows (CDR-like)", as_binary)):
-        c0 = time.process_time()
-        messages = encode()
-        c1 = time.process_time()
-        raw = b"".join(messages)
-        packed = zstandard.compress(raw)
-        c2 = time.process_time()
-        lines.append(f"| {name} | {c1 - c0:.2f} | {c2 - c1:.2f} | {len(raw) / 1e6:.0f} | {len(packed) / 1e6:.0f} |")
-    return lines
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--hours", type=float, default=1.0, help="simulated hours per run (default 1)")
@@ -324,8 +279,8 @@ def main(argv: list[str] | None = None) -> int:
         counts = [f"{parts[m][process].get('calls', 0):,.0f}" if process in parts[m] else "" for m in modes]
         lines.append(f"| {process} | wrapped calls (the profile's own cost: about 2 us each) | " + " | ".join(counts)
                      + " |")
-    lines += ["", f"## What binary columns would save: {args.hours:g} h of the sensors topic (6 sensors, 100 Hz)", "",
-              *encoding_estimate(args.hours)]
+    lines += ["", "The log's encodings compared on an hour of messages: benchmarks/results/encoding.md "
+              "(bench_encoding.py)."]
     text = "\n".join(lines).rstrip() + "\n"
     print(text)
     write_report(text, args.out)
