@@ -292,6 +292,22 @@ class LiveSumo(FramedSource):
         raise NotImplementedError
 
 
+@dataclass
+class _AxleLayout:
+    """The contact points of one set of followed vehicles (:meth:`SumoTraffic._new_layout`)."""
+
+    vehicles: tuple[str, ...]  # sorted
+    vehicle_types: list[str]  # each vehicle's (its own, for a vehicle with its own loads)
+    slots: np.ndarray  # each vehicle's trail
+    owner: np.ndarray  # each contact point's vehicle (row)
+    back: np.ndarray  # each contact point's distance behind the bumper, m
+    left: np.ndarray | None  # each contact point's offset to the left of its path, m (None: all on it)
+    wander: np.ndarray | None  # each contact point's vehicle's wander in its lane, m (None: no loads' table)
+    ids: tuple[str, ...]  # each contact point's id (``vehicle#k`` for axle k of several)
+    types: tuple[str, ...]  # each contact point's model key
+    unrecorded: bool  # a vehicle whose load record has not gone out
+
+
 class SumoTraffic(LiveSumo):
     """Vehicles from a SUMO simulation stepped in this process (through libsumo), as a traffic source.
 
@@ -342,6 +358,7 @@ class SumoTraffic(LiveSumo):
         self._watched: set[str] = set()
         self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
         self._fixed: dict[str, tuple[str, float]] = {}  # each followed vehicle's SUMO type and length, m
+        self._layout: _AxleLayout | None = None  # the contact points of the vehicles followed at the last step
 
     @property
     def half_width(self) -> float:
@@ -568,6 +585,48 @@ class SumoTraffic(LiveSumo):
             return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
         ids = sorted(present)
         position, angle, speed, acceleration = veh.getPosition, veh.getAngle, veh.getSpeed, veh.getAcceleration
+        num = np.array([(*position(vid), angle(vid), speed(vid), acceleration(vid), fixed[vid][1]) for vid in ids],
+                       dtype=float)
+        layout = self._layout
+        if layout is None or layout.vehicles != tuple(ids):
+            layout = self._layout = self._new_layout(ids, num)
+        # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
+        # it drove (cosim.core.axle_paths).
+        record_fronts(num, layout.slots, trails.arrays, self.step)
+        # Axles on the deck's width (or beside it, over its length) and within the watched reach along it (a
+        # vehicle on a long lane after the deck is dropped once far from it); a vehicle's axles stay together
+        # (one body, several axles).
+        beside = 0.0 if self.settings.edges else BESIDE_DECK
+        owner = layout.owner
+        x, y, v, a, keep = axles_on_path(num, layout.slots, trails.arrays, layout.back, owner, self._axis_frame,
+                                         self.deck_y, self._x_range, (0.0, self.axis.length, beside))
+        if layout.left is not None:  # wheels beside the path: across
+            along = self._unit[0]
+            heading = np.radians(num[:, 2])
+            ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
+            y = y + ahead[owner] * layout.left
+        if layout.wander is not None:  # each vehicle's wander within its lane
+            y = y + layout.wander
+        loads: tuple[LoadRecord, ...] = ()
+        if layout.unrecorded:  # a vehicle whose load record has not gone out yet
+            loads = self._entering(ids, layout.vehicle_types, num, owner, x, y)
+            if loads:
+                layout.unrecorded = any(vid not in self._recorded for vid in ids)
+        if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
+            self._drop_departed(ids, num)               # drop only reads a far vehicle a while longer
+        ids, types = layout.ids, layout.types
+        if not keep.all():
+            ids = tuple(i for i, k in zip(ids, keep) if k)
+            types = tuple(ty for ty, k in zip(types, keep) if k)
+            x, y, v, a = x[keep], y[keep], v[keep], a[keep]
+        return Frame(t=t, ids=ids, x=x, y=y, v=v, a=a, types=types, loads=loads)
+
+    def _new_layout(self, ids: list[str], num: np.ndarray) -> _AxleLayout:
+        """The contact points of a set of followed vehicles (sorted ids), which stay the same from step to step
+        while the set does: each vehicle's type (a new one modelled), first sight (trail, loads), slot, its axles'
+        owners, distances behind the bumper, sideways offsets and wander, their ids and types."""
+        feed, fixed, trails = self._feed, self._fixed, self._trails
+        assert trails is not None
         vtypes = [fixed[vid][0] for vid in ids]
         if feed is not None and feed.live:  # a record's SUMO type is its own (its length): modelled as its vType's
             live = feed.live
@@ -576,10 +635,6 @@ class SumoTraffic(LiveSumo):
             if typ not in self.types:
                 self._model(typ)
                 self._extend_reach()  # a longer vehicle than any known so far: watch farther
-        # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
-        # it drove (cosim.core.axle_paths).
-        num = np.array([(*position(vid), angle(vid), speed(vid), acceleration(vid), fixed[vid][1]) for vid in ids],
-                       dtype=float)
         for j, vid in enumerate(ids):
             if vid not in trails.slot_of:
                 trails.add(vid)
@@ -587,43 +642,29 @@ class SumoTraffic(LiveSumo):
                 self._first_sight(vid, vtypes[j], num[j])
         own = self._own
         types = [own[vid].id if vid in own else typ for vid, typ in zip(ids, vtypes)] if own else vtypes
-        slots = trails.slots(ids)
-        record_fronts(num, slots, trails.arrays, self.step)
-        vehicles, vehicle_types = ids, types
+        lengths = num[:, 5]
+        axle_ids, axle_types = ids, types
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(ids))
-            back = 0.5 * num[:, 5]
+            back = 0.5 * lengths
         else:
             owner = np.array([i for i, typ in enumerate(types) for _ in self._axles[typ]], dtype=np.int64)
             back = np.array([d if len(self._axles[typ]) > 1 else 0.5 * length
-                             for typ, length in zip(types, num[:, 5]) for d, _ in self._axles[typ]], dtype=float)
-            ids = [vid if len(self._axles[typ]) == 1 else f"{vid}#{k}"
-                   for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
-            types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
-                     for typ in types for k in range(len(self._axles[typ]))]
-        # Axles on the deck's width (or beside it, over its length) and within the watched reach along it (a
-        # vehicle on a long lane after the deck is dropped once far from it); a vehicle's axles stay together
-        # (one body, several axles).
-        beside = 0.0 if self.settings.edges else BESIDE_DECK
-        x, y, v, a, keep = axles_on_path(num, slots, trails.arrays, back, owner, self._axis_frame, self.deck_y,
-                                         self._x_range, (0.0, self.axis.length, beside))
-        if self._sideways and not self._sideways.isdisjoint(vehicle_types):  # wheels beside the path: across
-            left = np.array([side for typ in vehicle_types for _, side in self._axles[typ]])
-            along = self._unit[0]
-            heading = np.radians(num[:, 2])
-            ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
-            y = y + ahead[owner] * left
-        if self._draws is not None or feed is not None:  # each vehicle's wander within its lane
-            offsets = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in vehicles])
-            y = y + offsets[owner]
-        loads = self._entering(vehicles, vehicle_types, num, owner, x, y)
-        if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
-            self._drop_departed(vehicles, num)          # drop only reads a far vehicle a while longer
-        if not keep.all():
-            ids = [i for i, k in zip(ids, keep) if k]
-            types = [ty for ty, k in zip(types, keep) if k]
-            x, y, v, a = x[keep], y[keep], v[keep], a[keep]
-        return Frame(t=t, ids=tuple(ids), x=x, y=y, v=v, a=a, types=tuple(types), loads=loads)
+                             for typ, length in zip(types, lengths) for d, _ in self._axles[typ]], dtype=float)
+            axle_ids = [vid if len(self._axles[typ]) == 1 else f"{vid}#{k}"
+                        for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
+            axle_types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
+                          for typ in types for k in range(len(self._axles[typ]))]
+        left = None
+        if self._sideways and not self._sideways.isdisjoint(types):
+            left = np.array([side for typ in types for _, side in self._axles[typ]])
+        wander = None
+        if self._draws is not None or feed is not None:
+            wander = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in ids])[owner]
+        return _AxleLayout(vehicles=tuple(ids), vehicle_types=types, slots=trails.slots(ids), owner=owner, back=back,
+                           left=left, wander=wander, ids=tuple(axle_ids), types=tuple(axle_types),
+                           unrecorded=any(vid not in self._recorded for vid in ids))
+
 
     # ----------------------------------------------------------------- loads
     def _first_sight(self, vid: str, vtype: str, row: np.ndarray) -> None:
@@ -698,6 +739,7 @@ class SumoTraffic(LiveSumo):
         self._label.pop(vid, None)
         self._recorded.discard(vid)
         self._fixed.pop(vid, None)
+        self._layout = None  # its slot is free: a vehicle seen again with the same id is new
 
     def _seed_trail(self, vid: str, row: np.ndarray) -> None:
         """A vehicle seen for the first time: its trail starts with its lane behind its bumper (a vehicle
