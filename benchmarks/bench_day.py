@@ -1,14 +1,16 @@
 """A day of traffic: co-simulation against SUMO alone, real-time factors, step costs, memory (run on demand).
 
     python benchmarks/bench_day.py [--hours 1] [--reps 1] [--out benchmarks/results/day.md]
-    python benchmarks/bench_day.py --hours 24 --only direct+log     # the 24 h run whose figures are committed
+    python benchmarks/bench_day.py --hours 1 --reps 2 --day-hours 24  # issue 27's goals, in one run
 
 Side by side in one run, on the default run's config (`cosim run` with no
 arguments: the paper bridge under medium SUMO traffic, class A road, dt = 5 ms,
 log at 100 Hz), for the chosen number of simulated hours:
 
-- SUMO alone: the same config, step and subscriptions (`SumoTraffic.advance`
-  for every SUMO step, no bridge);
+- a plain libsumo loop: the same SUMO config, step, end and seed, `simulationStep`
+  until the end and nothing read (issue 27's yardstick);
+- SUMO alone: the same config and step through cosim's adapter (`SumoTraffic.advance`
+  for every SUMO step: the vehicles near the deck read and turned into contact points, no bridge);
 - the co-simulation with the direct (full FE) and the modal (30 modes) basis,
   with and without the MCAP log, through the same code as `cosim run`
   (`run_logged` with the log; `simulate` in constant memory without, with SUMO
@@ -22,7 +24,13 @@ log at 100 Hz), for the chosen number of simulated hours:
   log writer or SUMO's) and log size.
 
 Each configuration runs in its own process (libsumo is a per-process
-singleton); ratios come from the same run, so machine speed cancels. Then,
+singleton), timed from its first step (kernels compiled and 20 s of traffic
+run before); ratios come from the same run, so machine speed cancels. Then
+whole processes, as a user runs them (`--skip-whole` leaves them out):
+`cosim run` of the default scenario for the same hours, its log written,
+against a plain libsumo loop over the same config, in turn, ratio pair by
+pair; and start-up: Python's own start, `cosim --help`, and `cosim run` for
+one SUMO step (start-up to the first step, then closing its log). Then,
 in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
 deck for both bases (benchmarks/bench_step.py's set-up), and OpenSeesPy per
 step with 8 moving forces when it is installed (`pip install '.[bench]'`).
@@ -34,9 +42,12 @@ import datetime
 import json
 import os
 import platform
+import resource
+import shutil
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -152,12 +163,123 @@ def opensees_cost() -> float | None:
     return 1e6 * (time.perf_counter() - t0) / 500
 
 
+PLAIN_LIBSUMO = r"""
+import sys
+import libsumo
+cfg, step, end, seed = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
+libsumo.start(["sumo", "-c", cfg, "--step-length", repr(step), "--begin", "0", "--end", repr(end),
+               "--step-method.ballistic", "true", "--no-step-log", "true", "--no-warnings", "true", "--seed", seed])
+for _ in range(int(round(end / step))):
+    libsumo.simulationStep()
+libsumo.close()
+"""
+
+
+def _timed(cmd: list[str], env: dict[str, str]) -> tuple[float, float]:
+    """Wall and CPU seconds (user + system, the process and everything it waited for) of one whole process."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    started = time.perf_counter()
+    out = subprocess.run(cmd, capture_output=True, text=True, check=False, env=env)
+    wall = time.perf_counter() - started
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if out.returncode != 0:
+        tail = out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"exit {out.returncode}"
+        raise RuntimeError(f"{' '.join(cmd[:4])}...: {tail}")
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu
+
+
+def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str]:
+    """`cosim run` of the default scenario for ``hours`` as a user runs it (a whole process, its start-up and
+    its log included) against a plain libsumo loop over the same SUMO config, step, end and seed, in turn
+    (A B A B ...: the ratio is taken pair by pair); then start-up: Python's own, `cosim --help`, and `cosim run`
+    of the same scenario for one SUMO step (start-up to the first step, plus closing the log); with ``day_hours``,
+    one `cosim run` of that many hours too (issue 27's day: no 3D scene past an hour, SUMO in its own process)."""
+    import tomllib
+
+    from cosim.run.scenario import load_scenario
+    from cosim.run.simulate import plan_sumo
+    from cosim.run.toml_writer import toml_dumps
+
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # as an installed package runs: its modules compiled once
+    folder = Path(tempfile.mkdtemp(prefix="bench-day-"))
+    base = load_scenario("paper-bridge-traffic")
+    data = tomllib.loads(base.text)
+    data["traffic"]["end"] = 3600.0 * hours
+    (folder / "day.toml").write_text(toml_dumps(data), encoding="utf-8")
+    data["traffic"]["end"] = data["traffic"]["step"]
+    (folder / "first-step.toml").write_text(toml_dumps(data), encoding="utf-8")
+    data["traffic"]["end"] = 3600.0 * day_hours
+    (folder / "day-long.toml").write_text(toml_dumps(data), encoding="utf-8")
+    (folder / "plain.py").write_text(PLAIN_LIBSUMO, encoding="utf-8")
+    settings = plan_sumo(base).settings
+    plain = [sys.executable, str(folder / "plain.py"), str(settings.config), repr(settings.step),
+             repr(3600.0 * hours), str(settings.seed)]
+    cosim = [sys.executable, "-m", "cosim", "run", str(folder / "day.toml"), "--out", str(folder / "run.mcap"),
+             "--force", "--quiet"]
+    first = [sys.executable, "-m", "cosim", "run", str(folder / "first-step.toml"), "--out",
+             str(folder / "first.mcap"), "--force", "--quiet"]
+    python = [sys.executable, "-c", "pass"]
+    helps = [sys.executable, "-m", "cosim", "--help"]
+    _timed(first, env)  # compiled kernels in numba's cache, modules compiled, the section in its cache
+    runs: dict[str, list[tuple[float, float]]] = {"cosim": [], "plain": []}
+    for _ in range(reps):
+        runs["cosim"].append(_timed(cosim, env))
+        runs["plain"].append(_timed(plain, env))
+    log_mb = (folder / "run.mcap").stat().st_size / 1e6
+    starts: dict[str, list[float]] = {"python": [], "help": [], "first": []}
+    for _ in range(5):
+        starts["python"].append(_timed(python, env)[0])
+        starts["help"].append(_timed(helps, env)[0])
+        starts["first"].append(_timed(first, env)[0])
+    day = None
+    if day_hours > 0:
+        day = _timed([sys.executable, "-m", "cosim", "run", str(folder / "day-long.toml"), "--out",
+                      str(folder / "day.mcap"), "--force", "--quiet"], env)
+        day_mb = (folder / "day.mcap").stat().st_size / 1e6
+    shutil.rmtree(folder, ignore_errors=True)
+    ratios = [c[0] / p[0] for c, p in zip(runs["cosim"], runs["plain"])]
+    med = statistics.median
+    py = med(starts["python"])
+    lines = [
+        f"## Whole processes: `cosim run` against a plain libsumo loop ({hours:g} simulated hour(s))", "",
+        "`cosim run` of the default scenario with `[traffic] end` set to the hours, its log written (as a user "
+        "runs it: start-up, section from its cache, SUMO, the solver, the log writer, the summary), against a "
+        "Python process that starts libsumo on the same SUMO config, step, end and seed and calls "
+        f"`simulationStep` until the end, nothing read. In turn, {reps} pair(s); the ratio pair by pair; "
+        "median (range).", "",
+        "| process | wall [s] | CPU [s] (all its processes) |", "|---|---|---|",
+        f"| `cosim run` | {med(w for w, _ in runs['cosim']):.1f} | {med(c for _, c in runs['cosim']):.1f} |",
+        f"| plain libsumo loop | {med(w for w, _ in runs['plain']):.1f} | {med(c for _, c in runs['plain']):.1f} |",
+        "",
+        f"**`cosim run` / plain libsumo: {med(ratios):.2f}** ({min(ratios):.2f}-{max(ratios):.2f}); "
+        f"the log: {log_mb:.1f} MB.", "",
+        "## Start-up (whole processes, median of 5)", "",
+        "| process | wall [s] | above Python's own start [s] |", "|---|---|---|",
+        f"| `python -c pass` | {py:.2f} | |",
+        f"| `cosim --help` | {med(starts['help']):.2f} | {med(starts['help']) - py:.2f} |",
+        f"| `cosim run` for one SUMO step (start-up to the first step, then closing the log) | "
+        f"{med(starts['first']):.2f} | {med(starts['first']) - py:.2f} |",
+    ]
+    if day is not None:
+        lines += ["", f"## {day_hours:g} simulated hours in one `cosim run` (a whole process, once)", "",
+                  f"Wall {day[0]:.0f} s ({day[0] / 60:.1f} min), CPU {day[1]:.0f} s (all its processes); "
+                  f"real-time factor {3600.0 * day_hours / day[0]:.0f}; the log {day_mb:.0f} MB. Past an hour "
+                  "the 3D scene is off by default, and SUMO steps in a process of its own."]
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--hours", type=float, default=1.0, help="simulated hours per run (default 1)")
     ap.add_argument("--reps", type=int, default=1, help="repetitions of each run, the best counts (default 1)")
     ap.add_argument("--only", nargs="*", choices=RUNS, help="only these runs (SUMO alone is always run)")
     ap.add_argument("--skip-steps", action="store_true", help="leave out the per-step costs and OpenSeesPy")
+    ap.add_argument("--day-hours", type=float, default=0.0,
+                    help="also one whole `cosim run` of this many simulated hours (issue 27's goal: 24)")
+    ap.add_argument("--skip-whole", action="store_true",
+                    help="leave out the whole processes (cosim run against a plain libsumo loop) and start-up")
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT)
     args = ap.parse_args(argv)
     runs = ["sumo", *[r for r in RUNS if r != "sumo" and (not args.only or r in args.only)]]
@@ -207,6 +329,8 @@ def main(argv: list[str] | None = None) -> int:
         memory = f"{r['max_rss_mb']:.0f}" + (f" + {r['writer_rss_mb']:.0f}" if r.get("writer_rss_mb") else "")
         lines.append(f"| {mode} | {r['wall']:.1f} | {sim / r['wall']:.0f} | {ratio} | {memory} | "
                      f"{log_mb} | {r.get('vehicles', '')} |")
+    if not args.skip_whole:
+        lines += ["", *whole_processes(args.hours, max(args.reps, 1), args.day_hours)]
     if not args.skip_steps:
         lines += ["", "## Microseconds per step (process time, paper bridge, quarter-cars on the deck)", "",
                   "| basis | 0 | 1 | 8 | 16 | 64 |", "|---|---|---|---|---|---|"]

@@ -51,7 +51,7 @@ DEFAULT_OUT = HERE / "results" / "profile.md"
 PARTS = {
     "run": [
         ("sumo.step", "SUMO's steps (`libsumo.simulationStep`)"),
-        ("sumo.adapter", "the adapter: SUMO's subscriptions read into frames (`SumoTraffic.advance` less steps)"),
+        ("sumo.adapter", "the adapter: SUMO read into frames (`SumoTraffic.advance` less steps)"),
         ("frames", "frame interpolation to the solver's steps (`FrameTraffic.block`, `SumoProcess.block`)"),
         ("handover", "hand-over of blocks to the log writer (`_BlockStream.on_block`: pickling, the pipe)"),
         ("framesink", "hand-over of SUMO frames to the log writer (`_FrameSink`)"),
