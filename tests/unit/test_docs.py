@@ -92,7 +92,12 @@ def _resolves(dotted: str) -> bool:
 
 
 #: ``cosim.<key>`` names that are not Python: SUMO vType params, and the misspelt one an error example shows.
-NOT_PYTHON = {f"cosim.{key}" for key in param_keys()} | {"cosim.kv"}
+# The log's protobuf messages (package cosim: cosim/log/cosim.proto, and each run's cosim.SensorSample) and the
+# .proto file itself are names of the log, not of the package.
+PROTO_MESSAGES = {f"cosim.{name}" for name in
+                  re.findall(r"^message (\w+)", (REPO / "cosim" / "log" / "cosim.proto").read_text(), re.M)}
+NOT_PYTHON = ({f"cosim.{key}" for key in param_keys()} | {"cosim.kv", "cosim.proto", "cosim.SensorSample"}
+              | PROTO_MESSAGES)
 
 
 @pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(REPO)) for p in PAGES])
