@@ -286,19 +286,32 @@ def main(argv: list[str] | None = None) -> int:
     started = datetime.datetime.now()
     best: dict[str, dict] = {}
     ratios: dict[str, list[float]] = {mode: [] for mode in runs}  # per repetition: against that repetition's SUMO
+    plain: dict[str, list[float]] = {mode: [] for mode in runs}  # and against its plain libsumo loop
     for _ in range(args.reps):
         sumo_now = None
+        walls: dict[str, float] = {}
         for mode in runs:
             r = run_one(mode, args.hours)
             print(mode, r, flush=True)
             if "error" in r or mode not in best or r["wall"] < best[mode].get("wall", float("inf")):
                 best[mode] = r
             if "error" not in r:
+                walls[mode] = r["wall"]
                 if mode == "sumo":
                     sumo_now = r["wall"]
                 elif sumo_now:
                     ratios[mode].append(r["wall"] / sumo_now)
+        if "libsumo" in walls:
+            for mode, wall in walls.items():
+                plain[mode].append(wall / walls["libsumo"])
     sim = 3600.0 * args.hours
+
+    def spread(values: list[float]) -> str:
+        if not values:
+            return "-"
+        return f"{statistics.median(values):.2f}" + (f" ({min(values):.2f}-{max(values):.2f})"
+                                                     if len(values) > 1 else "")
+
     lines = [
         f"# A day of traffic: {args.hours:g} simulated hour(s) of the default run",
         "",
@@ -313,22 +326,23 @@ def main(argv: list[str] | None = None) -> int:
         "both): the log writer process with a log, SUMO's process without (`cosim.run.sumo_process`); with a log "
         "but no scene, both are children.",
         "",
-        "| run | wall [s] | real-time factor | / SUMO alone | peak memory [MB] | log [MB] | vehicles |",
-        "|---|---|---|---|---|---|---|",
+        "Timed from the first step (start-up left out: the whole processes below include it). `/ plain "
+        "libsumo`: against the plain libsumo loop of the same repetition.",
+        "",
+        "| run | wall [s] | real-time factor | / SUMO alone | / plain libsumo | peak memory [MB] | log [MB] | "
+        "vehicles |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for mode in runs:
         r = best[mode]
         if "error" in r:
-            lines.append(f"| {mode} | failed: {r['error']} | | | | | |")
+            lines.append(f"| {mode} | failed: {r['error']} | | | | | | |")
             continue
-        ratio = "1.00" if mode == "sumo" else (
-            f"{statistics.median(ratios[mode]):.2f}" + (f" ({min(ratios[mode]):.2f}-{max(ratios[mode]):.2f})"
-                                                        if len(ratios[mode]) > 1 else "")
-            if ratios[mode] else "-")
+        ratio = "1.00" if mode == "sumo" else spread(ratios[mode])
         log_mb = f"{r['log_bytes'] / 1e6:.1f}" if r.get("log_bytes") else ""
         memory = f"{r['max_rss_mb']:.0f}" + (f" + {r['writer_rss_mb']:.0f}" if r.get("writer_rss_mb") else "")
-        lines.append(f"| {mode} | {r['wall']:.1f} | {sim / r['wall']:.0f} | {ratio} | {memory} | "
-                     f"{log_mb} | {r.get('vehicles', '')} |")
+        lines.append(f"| {mode} | {r['wall']:.1f} | {sim / r['wall']:.0f} | {ratio} | {spread(plain[mode])} | "
+                     f"{memory} | {log_mb} | {r.get('vehicles', '')} |")
     if not args.skip_whole:
         lines += ["", *whole_processes(args.hours, max(args.reps, 1), args.day_hours)]
     if not args.skip_steps:

@@ -85,7 +85,7 @@ def _serve(settings: SumoSettings, out: Connection, control: Connection) -> None
             "types": dict(traffic.types), "models": dict(traffic.models), "table": table}))
         per_message = max(1, int(round(AHEAD_SECONDS / traffic.step)))
         sent_types: set[str] = set(traffic.types)
-        sent_models: set[str] = set(traffic.models)
+        traffic.take_new_models()  # those of the start went with "started"
         while not control.poll():
             batch: list[Frame] = []
             error: tuple[str, str] | None = None
@@ -96,10 +96,9 @@ def _serve(settings: SumoSettings, out: Connection, control: Connection) -> None
                 except BaseException as exc:  # noqa: BLE001 - after the frames before it
                     error = (type(exc).__name__, str(exc))
                     break
-            new_types = {k: v for k, v in traffic.types.items() if k not in sent_types}
-            new_models = {k: v for k, v in traffic.models.items() if k not in sent_models}
+            new_types = {k: v for k, v in traffic.types.items() if k not in sent_types}  # a few vTypes
+            new_models = traffic.take_new_models()  # not every model so far: a day makes tens of thousands
             sent_types.update(new_types)
-            sent_models.update(new_models)
             out.send(("frames", pack_frames(batch), new_types, new_models, traffic.teleports))
             if error is not None:
                 out.send(("error", *error))

@@ -227,6 +227,13 @@ class LiveSumo(FramedSource):
         """Every vehicle type known so far -> its model (read-only)."""
         return MappingProxyType(self._models)
 
+    def take_new_models(self) -> dict[str, VehicleModel]:
+        """The vehicle types known since the last call (or the last frame handed on), no longer new after it:
+        what a consumer of the frames has not seen yet, without going through every type so far (a day of
+        vehicles with their own loads makes tens of thousands)."""
+        fresh, self._fresh = self._fresh, {}
+        return fresh
+
     def _known(self, models: Mapping[str, VehicleModel]) -> None:
         """More vehicle types (those already known are kept as they are)."""
         for key, model in models.items():
@@ -269,7 +276,7 @@ class LiveSumo(FramedSource):
             if self.begin + frames.last_time + self.step > self.end + 1e-9:
                 raise SumoError(f"SUMO's run ends at {self.end} s; the co-simulation asked for {times[-1]} s")
             frame = self._next_frame()
-            fresh, self._fresh = self._fresh, {}
+            fresh = self.take_new_models()
             frames.add_frame(frame, fresh)
             if self.frame_sink is not None:
                 self.frame_sink(frame, fresh)
