@@ -30,7 +30,9 @@ whole processes, as a user runs them (`--skip-whole` leaves them out):
 `cosim run` of the default scenario for the same hours, its log written,
 against a plain libsumo loop over the same config, in turn, ratio pair by
 pair; and start-up: Python's own start, `cosim --help`, and `cosim run` for
-one SUMO step (start-up to the first step, then closing its log). Then,
+one SUMO step (start-up to the first step, then closing its log); and the
+log writer's CPU per simulated hour per topic (direct + log with its scene,
+timed as benchmarks/profile_day.py times it). Then,
 in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
 deck for both bases (benchmarks/bench_step.py's set-up), and OpenSeesPy per
 step with 8 moving forces when it is installed (`pip install '.[bench]'`).
@@ -270,6 +272,28 @@ def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str
     return lines
 
 
+def writer_topics(hours: float) -> list[str]:
+    """The log writer's CPU per simulated hour per topic in the default run (direct + log, its 3D scene), each
+    part timed with the writer thread's CPU time around the function that writes it (profile_day.py's worker)."""
+    import profile_day
+
+    with tempfile.TemporaryDirectory() as folder:
+        result = profile_day.run_one("direct+log", hours, Path(folder))
+    if "error" in result:
+        return ["## The log writer's CPU per topic", "", f"failed: {result['error']}"]
+    writer = profile_day.parts_of(result).get("cosim-log-writer", {})
+    topics = [("scene", "`/cosim/scene` (3D scene)"), ("vehicles", "`/cosim/vehicles`"),
+              ("piece", "`/cosim/sensors` and `/cosim/status`"), ("traffic", "`/cosim/traffic` (SUMO's frames)"),
+              ("events", "`/cosim/events`"), ("recv", "receiving blocks and frames from the run"),
+              ("writer.rest", "the rest (closing, summary, attachments)")]
+    lines = ["## The log writer's CPU per topic (direct + log, with the 3D scene; profile_day.py's parts)", "",
+             "| topic | CPU s per simulated hour |", "|---|---|"]
+    lines += [f"| {label} | {writer.get(key, 0.0) / hours:.2f} |" for key, label in topics]
+    lines += [f"| of these, zstd of the chunks | {writer.get('zstd', 0.0) / hours:.2f} |",
+              f"| **the writer's process** | **{writer.get('total', 0.0) / hours:.2f}** |"]
+    return lines
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--hours", type=float, default=1.0, help="simulated hours per run (default 1)")
@@ -345,6 +369,7 @@ def main(argv: list[str] | None = None) -> int:
                      f"{memory} | {log_mb} | {r.get('vehicles', '')} |")
     if not args.skip_whole:
         lines += ["", *whole_processes(args.hours, max(args.reps, 1), args.day_hours)]
+        lines += ["", *writer_topics(args.hours)]
     if not args.skip_steps:
         lines += ["", "## Microseconds per step (process time, paper bridge, quarter-cars on the deck)", "",
                   "| basis | 0 | 1 | 8 | 16 | 64 |", "|---|---|---|---|---|---|"]
