@@ -152,8 +152,8 @@ def record_fronts(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, 
     at most the travel of the mean speed over the step (a lane change's sideways jump adds nothing; on a
     curve it is the chord). The newest point is always the bumper; it replaces the newest kept point while
     that lies less than :data:`MIN_SPACING` after the one before it."""
-    # The arrays go in one by one: numba types a named tuple argument in Python at every call (about 50 us,
-    # most of the adapter's step), an array in C.
+    # The arrays go in one by one: numba's dispatch of a named tuple of six arrays costs about 1.5 us more a
+    # call than of the arrays themselves (measured: 3.1 against 1.5 us).
     _record_fronts(vehicles, slots, *trails, step)
 
 
