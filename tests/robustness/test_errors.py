@@ -268,3 +268,41 @@ def test_a_log_that_cannot_be_finished_says_up_to_when_it_can_be_read(tmp_path: 
     assert log.truncated and log.final_status["state"] != "finished"
     assert 0 < stated < 20 and max(t for t, _ in log.messages["/cosim/sensors"]) / 1e9 == stated
     assert (tmp_path / "cut.mcap").stat().st_size <= 200_000
+
+
+THREAD_WRITER_CUT = r"""
+import resource, signal, sys
+from pathlib import Path
+from cosim.run.logged import LogCutShort, run_logged
+from cosim.run.scenario import load_scenario
+scenario = load_scenario("paper-double-tee")
+run_logged(scenario, Path("warm.mcap"), writer="thread")  # kernels compiled and cached before the limit
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
+try:
+    run_logged(scenario, Path("cut.mcap"), writer="thread")
+except LogCutShort as exc:
+    print(str(exc))
+    sys.exit(1)
+"""
+
+
+def test_a_log_written_by_a_thread_that_cannot_be_finished_says_so_too(tmp_path: Path) -> None:
+    """The same full disk where no log writer process can be forked (the log encoded by a thread of the run,
+    ``writer="thread"``): the run ends with the same LogCutShort and its readable time, not a raw OSError."""
+    import subprocess
+    import sys
+
+    from _robust import cli_env
+
+    from cosim.log import read_log
+
+    result = subprocess.run([sys.executable, "-c", THREAD_WRITER_CUT], capture_output=True, text=True, cwd=tmp_path,
+                            env=cli_env(), timeout=600)
+    assert result.returncode == 1, result.stderr[-2000:]
+    line = result.stdout.strip()
+    assert "\n" not in line and "cut.mcap: writing the log failed" in line and "File too large" in line, line
+    stated = float(line.split("read up to t = ")[1].split(" s")[0])
+    log = read_log(tmp_path / "cut.mcap")
+    assert log.truncated and log.final_status["state"] != "finished"
+    assert 0 < stated < 20 and max(t for t, _ in log.messages["/cosim/sensors"]) / 1e9 == stated
