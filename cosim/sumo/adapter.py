@@ -621,12 +621,12 @@ class SumoTraffic(LiveSumo):
                 layout.unrecorded = any(vid not in self._recorded for vid in ids)
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
             self._drop_departed(ids, num)               # drop only reads a far vehicle a while longer
-        ids, types = layout.ids, layout.types
+        axle_ids, axle_types = layout.ids, layout.types
         if not keep.all():
-            ids = tuple(i for i, k in zip(ids, keep) if k)
-            types = tuple(ty for ty, k in zip(types, keep) if k)
+            axle_ids = tuple(i for i, k in zip(axle_ids, keep) if k)
+            axle_types = tuple(ty for ty, k in zip(axle_types, keep) if k)
             x, y, v, a = x[keep], y[keep], v[keep], a[keep]
-        return Frame(t=t, ids=ids, x=x, y=y, v=v, a=a, types=types, loads=loads)
+        return Frame(t=t, ids=axle_ids, x=x, y=y, v=v, a=a, types=axle_types, loads=loads)
 
     def _new_layout(self, ids: list[str], num: np.ndarray) -> _AxleLayout:
         """The contact points of a set of followed vehicles (sorted ids), which stay the same from step to step
