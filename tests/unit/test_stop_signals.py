@@ -6,6 +6,7 @@ import os
 import signal
 import threading
 import time
+from typing import Any
 
 import pytest
 
@@ -14,10 +15,16 @@ from cosim.log.process import signals_held
 from cosim.run.signals import stop_signals
 
 
-def deliver(signum: signal.Signals) -> None:
-    """Send ``signum`` to this process; Python runs the handler at the next bytecode boundary."""
+def deliver(signum: signal.Signals, guard: Any = None) -> None:
+    """Send ``signum`` to this process; Python runs the handler at the next bytecode boundary. With ``guard``:
+    until its handler has counted it (a fixed 10 ms pause once let the second of two signals be handled first
+    in a loaded fresh-clone CI run; the cause was not pinned down)."""
+    before = getattr(guard, "received", 0)
     os.kill(os.getpid(), signum)
     time.sleep(0.01)
+    deadline = time.monotonic() + 10.0
+    while guard is not None and guard.received == before and time.monotonic() < deadline:
+        time.sleep(0.001)
 
 
 def test_the_first_signal_is_raised_and_later_ones_wait_for_the_block_to_end() -> None:
@@ -26,8 +33,8 @@ def test_the_first_signal_is_raised_and_later_ones_wait_for_the_block_to_end() -
     assert first.value.name == "SIGTERM" and guard.received == 1
     with pytest.raises(Interrupted) as held, stop_signals() as guard:
         guard.closing = True  # the log's ending is being written: must not be cut short
-        deliver(signal.SIGHUP)
-        deliver(signal.SIGINT)
+        deliver(signal.SIGHUP, guard)
+        deliver(signal.SIGINT, guard)
         assert guard.held is not None and guard.held.name == "SIGHUP"  # still running: nothing was raised
     assert held.value.name == "SIGHUP" and guard.received == 2
 
@@ -37,8 +44,8 @@ def test_held_signals_are_recorded_not_raised_and_the_first_is_raised_when_the_b
     distributed log a traceback); none is raised inside the block, none is lost."""
     with pytest.raises(Interrupted) as held, stop_signals(hold=True) as guard:
         assert guard.held is None
-        deliver(signal.SIGINT)
-        deliver(signal.SIGTERM)
+        deliver(signal.SIGINT, guard)
+        deliver(signal.SIGTERM, guard)
         assert guard.held is not None and guard.held.name == "SIGINT" and guard.received == 2
     assert held.value is guard.held and held.value.signum == signal.SIGINT
     before = signal.getsignal(signal.SIGTERM)
