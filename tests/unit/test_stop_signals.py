@@ -17,14 +17,26 @@ from cosim.run.signals import stop_signals
 
 def deliver(signum: signal.Signals, guard: Any = None) -> None:
     """Send ``signum`` to this process; Python runs the handler at the next bytecode boundary. With ``guard``:
-    until its handler has counted it (a fixed 10 ms pause once let the second of two signals be handled first
-    in a loaded fresh-clone CI run; the cause was not pinned down)."""
+    until its handler has counted it (at most 10 s), not for a fixed pause."""
     before = getattr(guard, "received", 0)
     os.kill(os.getpid(), signum)
     time.sleep(0.01)
     deadline = time.monotonic() + 10.0
     while guard is not None and guard.received == before and time.monotonic() < deadline:
         time.sleep(0.001)
+
+
+@pytest.fixture(autouse=True)
+def stop_signals_not_ignored() -> Any:
+    """These tests are about the guard, not about what the shell passed on: under ``nohup`` the process inherits
+    SIGHUP ignored, which the guard respects (the last test); here it is the default for each test."""
+    old = {signum: signal.getsignal(signum) for signum in (signal.SIGTERM, signal.SIGHUP)}
+    for signum, handler in old.items():
+        if handler == signal.SIG_IGN:
+            signal.signal(signum, signal.SIG_DFL)
+    yield
+    for signum, handler in old.items():
+        signal.signal(signum, handler)
 
 
 def test_the_first_signal_is_raised_and_later_ones_wait_for_the_block_to_end() -> None:
@@ -78,3 +90,14 @@ def test_a_signal_delivered_to_another_thread_waits_until_the_message_is_through
         other.join()
     assert stopped.value.name == "SIGTERM" and through == [True]
     assert receiver.poll(1) and receiver.recv_bytes() == payload  # the message arrived whole
+
+
+def test_a_signal_the_process_ignores_stays_ignored() -> None:
+    """A run started under ``nohup`` (SIGHUP ignored) is not stopped by a hangup: the guard leaves an ignored
+    signal as it found it, and it is never counted."""
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    with stop_signals() as guard:
+        os.kill(os.getpid(), signal.SIGHUP)
+        time.sleep(0.05)
+        assert guard.received == 0 and guard.held is None
+    assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
