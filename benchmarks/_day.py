@@ -46,3 +46,17 @@ def default_run(mode: str, hours: float) -> tuple[Any, Any]:
         simulate(bridge, traffic, 20.0, warm.solver_settings(), warm.sensors_core(), road=warm.build_road(),
                  output_every=warm.output_every, collect=False)
     return scenario, bridge
+
+
+def plain_libsumo(config: str, step: float, end: float, seed: int | None) -> None:
+    """Issue 27's yardstick: libsumo started on a SUMO config as cosim starts it (step, ballistic update, seed)
+    and stepped to ``end`` (s), nothing read. Imports libsumo only, so that as a whole process it is Python's
+    start, SUMO's and its steps."""
+    import libsumo
+
+    libsumo.start(["sumo", "-c", config, "--step-length", repr(step), "--begin", "0", "--end", repr(end),
+                   "--step-method.ballistic", "true", "--no-step-log", "true", "--no-warnings", "true",
+                   *(["--seed", str(seed)] if seed is not None else [])])
+    for _ in range(int(round(end / step))):
+        libsumo.simulationStep()
+    libsumo.close()

@@ -76,17 +76,10 @@ from cosim.core.simulation import simulate
 out = {"log_bytes": 0}
 started = time.perf_counter()
 if mode == "libsumo":  # the baseline of issue 27: SUMO's own loop over the same config, nothing read from it
-    import libsumo
+    from _day import plain_libsumo
     from cosim.run.simulate import plan_sumo
-    from cosim.sumo.adapter import sumo_binary
     s = plan_sumo(scenario).settings
-    libsumo.start([sumo_binary(), "-c", str(s.config), "--step-length", repr(s.step), "--begin", repr(s.begin),
-                   "--end", repr(s.end), "--step-method.ballistic", "true", "--no-step-log", "true",
-                   "--no-warnings", "true", *(["--seed", str(s.seed)] if s.seed is not None else []),
-                   *s.extra_args])
-    for _ in range(int(round(duration / s.step))):
-        libsumo.simulationStep()
-    libsumo.close()
+    plain_libsumo(str(s.config), s.step, duration, s.seed)
 elif mode == "sumo":
     from cosim.run.simulate import build_traffic
     with build_traffic(scenario, process=False) as traffic:  # SUMO and the adapter, in this process
@@ -167,13 +160,9 @@ def opensees_cost() -> float | None:
 
 PLAIN_LIBSUMO = r"""
 import sys
-import libsumo
-cfg, step, end, seed = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
-libsumo.start(["sumo", "-c", cfg, "--step-length", repr(step), "--begin", "0", "--end", repr(end),
-               "--step-method.ballistic", "true", "--no-step-log", "true", "--no-warnings", "true", "--seed", seed])
-for _ in range(int(round(end / step))):
-    libsumo.simulationStep()
-libsumo.close()
+sys.path.insert(0, sys.argv[1])
+from _day import plain_libsumo
+plain_libsumo(sys.argv[2], float(sys.argv[3]), float(sys.argv[4]), int(sys.argv[5]) if sys.argv[5] != "None" else None)
 """
 
 
@@ -214,9 +203,8 @@ def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str
     (folder / "first-step.toml").write_text(toml_dumps(data), encoding="utf-8")
     data["traffic"]["end"] = 3600.0 * day_hours
     (folder / "day-long.toml").write_text(toml_dumps(data), encoding="utf-8")
-    (folder / "plain.py").write_text(PLAIN_LIBSUMO, encoding="utf-8")
     settings = plan_sumo(base).settings
-    plain = [sys.executable, str(folder / "plain.py"), str(settings.config), repr(settings.step),
+    plain = [sys.executable, "-c", PLAIN_LIBSUMO, str(HERE), str(settings.config), repr(settings.step),
              repr(3600.0 * hours), str(settings.seed)]
     cosim = [sys.executable, "-m", "cosim", "run", str(folder / "day.toml"), "--out", str(folder / "run.mcap"),
              "--force", "--quiet"]

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 from collections import namedtuple
+from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -141,7 +142,7 @@ class AxleTrails:
         """The trails for the compiled passes (new arrays after a resize: take them anew each time)."""
         return TrailArrays(self.px, self.py, self.s, self.head, self.count, self.speed)
 
-    def slots(self, vehicles: list[str]) -> npt.NDArray[np.int64]:
+    def slots(self, vehicles: Sequence[str]) -> npt.NDArray[np.int64]:
         """The slot of each vehicle (all added)."""
         return np.array([self.slot_of[v] for v in vehicles], dtype=np.int64)
 

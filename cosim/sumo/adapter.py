@@ -515,11 +515,10 @@ class SumoTraffic(LiveSumo):
         subscriptions cost more inside each step than the getters they replace: benchmarks/results/profile.md)."""
         self._watched_lanes.update(watched_lanes(net, self.deck_lanes, self.reach))
         self.lanes = tuple(self._watched_lanes)
-
-    @property
-    def _x_range(self) -> tuple[float, float]:
-        """Contact points farther along the axis than this from the deck are not followed, m."""
-        return (-self.reach, self.axis.length + self.reach)
+        # The contact points kept (axles_on_path's region, bridge coordinates, m): on the deck's width within the
+        # reach along it, or beside the width over the deck's length (a bridge placed by its axis alone).
+        beside = 0.0 if self.settings.edges else BESIDE_DECK
+        self._region = (self.deck_y, (-self.reach, self.axis.length + self.reach), (0.0, self.axis.length, beside))
 
     def _extend_reach(self) -> None:
         """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
@@ -590,23 +589,21 @@ class SumoTraffic(LiveSumo):
         self._watched = present
         if not present:
             return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
-        ids = sorted(present)
+        ids = tuple(sorted(present))
         position, angle, speed, acceleration = veh.getPosition, veh.getAngle, veh.getSpeed, veh.getAcceleration
         num = np.array([(*position(vid), angle(vid), speed(vid), acceleration(vid), fixed[vid][1]) for vid in ids],
                        dtype=float)
         layout = self._layout
-        if layout is None or layout.vehicles != tuple(ids):
+        if layout is None or layout.vehicles != ids:
             layout = self._layout = self._new_layout(ids, num)
         # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
         # it drove (cosim.core.axle_paths).
         record_fronts(num, layout.slots, trails.arrays, self.step)
-        # Axles on the deck's width (or beside it, over its length) and within the watched reach along it (a
-        # vehicle on a long lane after the deck is dropped once far from it); a vehicle's axles stay together
-        # (one body, several axles).
-        beside = 0.0 if self.settings.edges else BESIDE_DECK
+        # Axles in the region kept (a vehicle on a long lane after the deck is dropped once far from it); a
+        # vehicle's axles stay together (one body, several axles).
         owner = layout.owner
         x, y, v, a, keep = axles_on_path(num, layout.slots, trails.arrays, layout.back, owner, self._axis_frame,
-                                         self.deck_y, self._x_range, (0.0, self.axis.length, beside))
+                                         *self._region)
         if layout.left is not None:  # wheels beside the path: across
             along = self._unit[0]
             heading = np.radians(num[:, 2])
@@ -628,7 +625,7 @@ class SumoTraffic(LiveSumo):
             x, y, v, a = x[keep], y[keep], v[keep], a[keep]
         return Frame(t=t, ids=axle_ids, x=x, y=y, v=v, a=a, types=axle_types, loads=loads)
 
-    def _new_layout(self, ids: list[str], num: np.ndarray) -> _AxleLayout:
+    def _new_layout(self, ids: tuple[str, ...], num: np.ndarray) -> _AxleLayout:
         """The contact points of a set of followed vehicles (sorted ids), which stay the same from step to step
         while the set does: each vehicle's type (a new one modelled), first sight (trail, loads), slot, its axles'
         owners, distances behind the bumper, sideways offsets and wander, their ids and types."""
@@ -650,7 +647,7 @@ class SumoTraffic(LiveSumo):
         own = self._own
         types = [own[vid].id if vid in own else typ for vid, typ in zip(ids, vtypes)] if own else vtypes
         lengths = num[:, 5]
-        axle_ids, axle_types = ids, types
+        axle_ids, axle_types = list(ids), types
         if all(len(self._axles[typ]) == 1 for typ in types):
             owner = np.arange(len(ids))
             back = 0.5 * lengths
@@ -668,7 +665,7 @@ class SumoTraffic(LiveSumo):
         wander = None
         if self._draws is not None or feed is not None:
             wander = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in ids])[owner]
-        return _AxleLayout(vehicles=tuple(ids), vehicle_types=types, slots=trails.slots(ids), owner=owner, back=back,
+        return _AxleLayout(vehicles=ids, vehicle_types=types, slots=trails.slots(ids), owner=owner, back=back,
                            left=left, wander=wander, ids=tuple(axle_ids), types=tuple(axle_types),
                            unrecorded=any(vid not in self._recorded for vid in ids))
 
@@ -702,7 +699,7 @@ class SumoTraffic(LiveSumo):
         self._known({key: model for key, model, _, _ in columns})
         self._own[vid] = own
 
-    def _entering(self, vehicles: list[str], types: list[str], num: np.ndarray, owner: np.ndarray, x: np.ndarray,
+    def _entering(self, vehicles: Sequence[str], types: list[str], num: np.ndarray, owner: np.ndarray, x: np.ndarray,
                   y: np.ndarray) -> tuple[LoadRecord, ...]:
         """The load records of the vehicles whose first contact point came onto the deck in this step: class,
         weights, axles, the lane it drives on (SUMO's), its speed, path and wander, and the loads' source."""
@@ -767,7 +764,7 @@ class SumoTraffic(LiveSumo):
         points, behind = path_behind(shape, length, position, row[:2], self.reach)
         self._trails.seed(vid, points, behind, float(row[3]))
 
-    def _drop_departed(self, ids: list[str], num: np.ndarray) -> None:
+    def _drop_departed(self, ids: Sequence[str], num: np.ndarray) -> None:
         """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
 
         They are still on a watched lane (a long lane after the deck) but can no longer reach it: they are
@@ -782,7 +779,7 @@ class SumoTraffic(LiveSumo):
         rear = front - num[:, 5] * along
         far = self.axis.length + self.reach
         gone = ((along > 0) & (np.minimum(front, rear) > far)) | ((along < 0) & (np.maximum(front, rear) < -self.reach))
-        for i in np.flatnonzero(gone):
+        for i in np.flatnonzero(gone).tolist():
             vid = ids[i]
             self._done.add(vid)
             self._watched.discard(vid)
