@@ -88,6 +88,8 @@ class AxleTrails:
         self.head = np.zeros(slots, dtype=np.int64)
         self.count = np.zeros(slots, dtype=np.int64)
         self.speed = np.zeros(slots)  # at the last point, m/s
+        #: The trails for the compiled passes (new arrays after a resize: take them anew each time).
+        self.arrays = TrailArrays(self.px, self.py, self.s, self.head, self.count, self.speed)
         self._free = list(range(slots - 1, -1, -1))
 
     def _resize(self, slots: int, capacity: int) -> None:
@@ -137,10 +139,6 @@ class AxleTrails:
         self.s[k, :n] = -np.asarray(behind[-n:], dtype=float)
         self.head[k], self.count[k], self.speed[k] = n - 1, n, speed
 
-    @property
-    def arrays(self) -> TrailArrays:
-        """The trails for the compiled passes (new arrays after a resize: take them anew each time)."""
-        return TrailArrays(self.px, self.py, self.s, self.head, self.count, self.speed)
 
     def slots(self, vehicles: Sequence[str]) -> npt.NDArray[np.int64]:
         """The slot of each vehicle (all added)."""
@@ -278,6 +276,80 @@ def _axles_on_path(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: 
     for i in range(m):
         keep[i] = kept_vehicle[owner[i]]
     return x, y, v, a, keep
+
+
+def contact_settings(deck_y: tuple[float, float], reach: float, length: float, beside: float, step: float
+                     ) -> np.ndarray:
+    """What :func:`contact_step` takes of a run, as one array: the region in which it keeps contact points
+    (bridge coordinates, m: the deck's width ``deck_y`` within ``reach`` before and after the deck, ``length``
+    long, or up to ``beside`` beyond the width over the deck's length: :func:`axles_on_path`'s ``y_range``,
+    ``x_range`` and ``span``), the deck's length and the traffic step (s)."""
+    return np.array([deck_y[0], deck_y[1], -reach, length + reach, 0.0, length, beside, length, step], dtype=float)
+
+
+def contact_step(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, back: np.ndarray, owner: np.ndarray,
+                 left: np.ndarray, wander: np.ndarray, axis: AxisFrame, settings: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, int, bool]:
+    """One traffic step of the followed vehicles in one compiled pass: :func:`record_fronts`, then
+    :func:`axles_on_path`, each contact point moved ``left`` of its path (m, to the left looking along the
+    vehicle's heading; an empty array: none is) and by its vehicle's ``wander`` (m, to the left of the bridge
+    axis; empty: none), and which vehicles have driven away beyond the region for good.
+
+    Args:
+        vehicles: (n, 6) per vehicle: front bumper x, y (m, network), heading (degrees, SUMO's), speed (m/s),
+            acceleration (m/s^2) and length (m).
+        slots, trails, back, owner, axis: as :func:`record_fronts` and :func:`axles_on_path` take them.
+        settings: :func:`contact_settings`.
+
+    Returns:
+        (4, m): x, y, v and a of :func:`axles_on_path` (y with the offsets); (m + n,): its ``keep`` for each
+        contact point, then for each vehicle whether it is gone (its whole length beyond the region along the
+        axis, driving away from the deck); how many contact points are kept; whether any is on the deck's
+        length (0 <= x <= length).
+    """
+    # One call instead of four numba calls and a dozen numpy operations on arrays of a few vehicles, and two
+    # arrays out instead of six: each cost about a microsecond at every SUMO step, more than the arithmetic.
+    return _contact_step(vehicles, slots, *trails, back, owner, left, wander, *axis, settings)
+
+
+@compiled
+def _contact_step(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: np.ndarray, s: np.ndarray,
+                  head: np.ndarray, count: np.ndarray, speed: np.ndarray, back: np.ndarray, owner: np.ndarray,
+                  left: np.ndarray, wander: np.ndarray, origin: np.ndarray, along: np.ndarray,
+                  left_of_axis: np.ndarray, settings: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, bool]:
+    _record_fronts(vehicles, slots, px, py, s, head, count, speed, settings[8])
+    x, y, v, a, keep = _axles_on_path(vehicles, slots, px, py, s, head, count, back, owner, origin, along,
+                                      left_of_axis, settings[0], settings[1], settings[2], settings[3],
+                                      settings[4], settings[5], settings[6])
+    n, m = vehicles.shape[0], back.shape[0]
+    if left.shape[0] > 0:  # wheels beside the path: to the left of the vehicle, whichever way it drives
+        for i in range(m):
+            heading = vehicles[owner[i], 2] * (math.pi / 180.0)
+            ahead = 1.0 if math.sin(heading) * along[0] + math.cos(heading) * along[1] >= 0.0 else -1.0
+            y[i] = y[i] + ahead * left[i]
+    if wander.shape[0] > 0:
+        for i in range(m):
+            y[i] = y[i] + wander[i]
+    out = np.empty((4, m))
+    marks = np.empty(m + n, dtype=np.bool_)
+    kept = 0
+    on_deck = False
+    for i in range(m):
+        out[0, i], out[1, i], out[2, i], out[3, i] = x[i], y[i], v[i], a[i]
+        marks[i] = keep[i]
+        if keep[i]:
+            kept += 1
+        if 0.0 <= x[i] <= settings[7]:
+            on_deck = True
+    for r in range(n):
+        heading = vehicles[r, 2] * (math.pi / 180.0)
+        hx, hy = math.sin(heading), math.cos(heading)
+        front = (vehicles[r, 0] - origin[0]) * along[0] + (vehicles[r, 1] - origin[1]) * along[1]
+        ahead = hx * along[0] + hy * along[1]
+        rear = front - vehicles[r, 5] * ahead
+        marks[m + r] = (ahead > 0.0 and min(front, rear) > settings[3]) or \
+            (ahead < 0.0 and max(front, rear) < settings[2])
+    return out, marks, kept, on_deck
 
 
 def path_behind(shape: npt.ArrayLike, lane_length: float, position: float, front: npt.ArrayLike,

@@ -32,6 +32,7 @@ imported inside :meth:`SumoTraffic.start`, so importing this module does not loa
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import os
 import shutil
@@ -46,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.axle_paths import AxisFrame, AxleTrails, axles_on_path, path_behind, record_fronts
+from cosim.core.axle_paths import AxisFrame, AxleTrails, contact_settings, contact_step, path_behind
 from cosim.core.traffic import Frame, FramedSource, FrameSink, FrameTraffic, LoadRecord, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
@@ -308,8 +309,8 @@ class _AxleLayout:
     slots: np.ndarray  # each vehicle's trail
     owner: np.ndarray  # each contact point's vehicle (row)
     back: np.ndarray  # each contact point's distance behind the bumper, m
-    left: np.ndarray | None  # each contact point's offset to the left of its path, m (None: all on it)
-    wander: np.ndarray | None  # each contact point's vehicle's wander in its lane, m (None: no loads' table)
+    left: np.ndarray  # each contact point's offset to the left of its path, m (empty: all on it)
+    wander: np.ndarray  # each contact point's vehicle's wander in its lane, m (empty: no loads' table)
     ids: tuple[str, ...]  # each contact point's id (``vehicle#k`` for axle k of several)
     types: tuple[str, ...]  # each contact point's model key
     unrecorded: bool  # a vehicle whose load record has not gone out
@@ -518,7 +519,7 @@ class SumoTraffic(LiveSumo):
         # The contact points kept (axles_on_path's region, bridge coordinates, m): on the deck's width within the
         # reach along it, or beside the width over the deck's length (a bridge placed by its axis alone).
         beside = 0.0 if self.settings.edges else BESIDE_DECK
-        self._region = (self.deck_y, (-self.reach, self.axis.length + self.reach), (0.0, self.axis.length, beside))
+        self._contact_settings = contact_settings(self.deck_y, self.reach, self.axis.length, beside, self.step)
 
     def _extend_reach(self) -> None:
         """Watch far enough for the longest vehicle type known so far (its last axle still on the deck)."""
@@ -572,10 +573,7 @@ class SumoTraffic(LiveSumo):
                 from None
         self.sumo_steps += 1
         t = self.sumo_steps * self.step
-        on_lane = ls.lane.getLastStepVehicleIDs
-        present: set[str] = set()
-        for lane in self.lanes:
-            present.update(on_lane(lane))
+        present = set(itertools.chain.from_iterable(map(ls.lane.getLastStepVehicleIDs, self.lanes)))
         self._done &= present  # a vehicle that left the watched lanes is forgotten
         present -= self._done
         veh = ls.vehicle
@@ -597,29 +595,24 @@ class SumoTraffic(LiveSumo):
         if layout is None or layout.vehicles != ids:
             layout = self._layout = self._new_layout(ids, num)
         # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
-        # it drove (cosim.core.axle_paths).
-        record_fronts(num, layout.slots, trails.arrays, self.step)
-        # Axles in the region kept (a vehicle on a long lane after the deck is dropped once far from it); a
-        # vehicle's axles stay together (one body, several axles).
+        # it drove, with its offsets (cosim.core.axle_paths). Axles in the region kept (a vehicle on a long lane
+        # after the deck is dropped once far from it); a vehicle's axles stay together (one body, several axles).
         owner = layout.owner
-        x, y, v, a, keep = axles_on_path(num, layout.slots, trails.arrays, layout.back, owner, self._axis_frame,
-                                         *self._region)
-        if layout.left is not None:  # wheels beside the path: across
-            along = self._unit[0]
-            heading = np.radians(num[:, 2])
-            ahead = np.where(np.sin(heading) * along[0] + np.cos(heading) * along[1] >= 0.0, 1.0, -1.0)
-            y = y + ahead[owner] * layout.left
-        if layout.wander is not None:  # each vehicle's wander within its lane
-            y = y + layout.wander
+        xyva, marks, kept, on_deck = contact_step(num, layout.slots, trails.arrays, layout.back, owner, layout.left,
+                                                  layout.wander, self._axis_frame, self._contact_settings)
+        x, y, v, a = xyva
         loads: tuple[LoadRecord, ...] = ()
-        if layout.unrecorded:  # a vehicle whose load record has not gone out yet
+        if layout.unrecorded and on_deck:  # a vehicle whose load record has not gone out yet
             loads = self._entering(ids, layout.vehicle_types, num, owner, x, y)
             if loads:
                 layout.unrecorded = any(vid not in self._recorded for vid in ids)
-        if self.sumo_steps % DROP_DEPARTED_EVERY == 0:  # costs a tenth of the adapter at every step; a late
-            self._drop_departed(ids, num)               # drop only reads a far vehicle a while longer
+        # Vehicles gone for good are dropped every few steps (not at once: same frames as when this took numpy
+        # operations at every step, and a late drop only reads a far vehicle a while longer).
         axle_ids, axle_types = layout.ids, layout.types
-        if not keep.all():
+        if self.sumo_steps % DROP_DEPARTED_EVERY == 0 and marks[len(axle_ids):].any():
+            self._drop_departed(ids, marks[len(axle_ids):])
+        if kept < len(axle_ids):
+            keep = marks[:len(axle_ids)]
             axle_ids = tuple(i for i, k in zip(axle_ids, keep) if k)
             axle_types = tuple(ty for ty, k in zip(axle_types, keep) if k)
             x, y, v, a = x[keep], y[keep], v[keep], a[keep]
@@ -659,10 +652,10 @@ class SumoTraffic(LiveSumo):
                         for vid, typ in zip(ids, types) for k in range(len(self._axles[typ]))]
             axle_types = [typ if len(self._axles[typ]) == 1 else f"{typ}#{k}"
                           for typ in types for k in range(len(self._axles[typ]))]
-        left = None
+        left = _EMPTY  # none beside its path
         if self._sideways and not self._sideways.isdisjoint(types):
             left = np.array([side for typ in types for _, side in self._axles[typ]])
-        wander = None
+        wander = _EMPTY  # none wanders
         if self._draws is not None or feed is not None:
             wander = np.array([self._label[vid][1] if vid in self._label else 0.0 for vid in ids])[owner]
         return _AxleLayout(vehicles=ids, vehicle_types=types, slots=trails.slots(ids), owner=owner, back=back,
@@ -764,21 +757,13 @@ class SumoTraffic(LiveSumo):
         points, behind = path_behind(shape, length, position, row[:2], self.reach)
         self._trails.seed(vid, points, behind, float(row[3]))
 
-    def _drop_departed(self, ids: Sequence[str], num: np.ndarray) -> None:
-        """Stop following vehicles whose whole length is beyond the watched reach, driving away from the deck.
+    def _drop_departed(self, ids: Sequence[str], gone: np.ndarray) -> None:
+        """Stop following the vehicles ``gone`` says are beyond the watched reach for good, driving away from the
+        deck (:func:`cosim.core.axle_paths.contact_step`).
 
         They are still on a watched lane (a long lane after the deck) but can no longer reach it: they are
-        no longer read, not at every step until they leave the lane. ``num`` rows: x, y, angle, ...,
-        length (network coordinates, the front bumper).
+        no longer read, not at every step until they leave the lane.
         """
-        heading = np.radians(num[:, 2])
-        hx, hy = np.sin(heading), np.cos(heading)
-        e, _ = self._unit
-        front = (num[:, 0] - self.axis.start[0]) * e[0] + (num[:, 1] - self.axis.start[1]) * e[1]
-        along = hx * e[0] + hy * e[1]
-        rear = front - num[:, 5] * along
-        far = self.axis.length + self.reach
-        gone = ((along > 0) & (np.minimum(front, rear) > far)) | ((along < 0) & (np.maximum(front, rear) < -self.reach))
         for i in np.flatnonzero(gone).tolist():
             vid = ids[i]
             self._done.add(vid)

@@ -11,6 +11,8 @@ from cosim.core.axle_paths import (
     AxisFrame,
     AxleTrails,
     axles_on_path,
+    contact_settings,
+    contact_step,
     path_behind,
     record_fronts,
     trail_capacity,
@@ -75,6 +77,58 @@ def test_axles_are_projected_onto_a_rotated_axis_and_kept_with_their_vehicle() -
     assert keep.tolist() == [True, True, True]
     _, _, _, _, keep = axles_on_path(*args, (-12.0, 100.0), (0.0, 100.0, 0.4))
     assert keep.tolist() == [True, True, False]
+
+
+def test_one_contact_step_gives_what_the_separate_passes_and_the_offsets_give_to_the_bit() -> None:
+    # Reference: record_fronts and axles_on_path one after the other, then the sideways offsets, the wander and
+    # the "gone" rule as numpy operations (the adapter's before contact_step merged them): equal to the bit.
+    rng = np.random.default_rng(7)
+    angle = np.radians(-20.0)
+    along, left = np.array([np.cos(angle), np.sin(angle)]), np.array([-np.sin(angle), np.cos(angle)])
+    axis = AxisFrame(np.array([30.0, -10.0]), along, left)
+    length, reach, deck_y, beside = 40.0, 26.5, (-6.0, 6.0), 3.75
+    settings = contact_settings(deck_y, reach, length, beside, STEP)
+    names = [f"v{k}" for k in range(5)]
+    owner = np.array([0, 0, 1, 2, 2, 2, 3, 4], dtype=np.int64)
+    back = rng.uniform(0.5, 14.0, owner.size)
+    side = rng.uniform(-1.0, 1.0, owner.size)
+    wander = rng.uniform(-0.3, 0.3, 5)[owner]
+    at = rng.uniform(-80.0, 120.0, 5)  # bumpers along the axis (m): some far before or after the deck
+    lateral = rng.uniform(-9.0, 9.0, 5)
+    heading = np.where(rng.random(5) < 0.5, 1.0, -1.0)  # each drives along the axis or against it
+    sumo_angle = [_sumo_angle(*(h * along)) for h in heading]
+    merged, separate = AxleTrails(reach), AxleTrails(reach)
+    for trails in (merged, separate):
+        for name in names:
+            trails.add(name)
+    for k in range(30):
+        bumper = axis.origin + np.outer(at + heading * 12.0 * STEP * k, along) + np.outer(lateral, left)
+        num = np.column_stack([bumper, sumo_angle, np.full(5, 12.0), rng.normal(0.0, 0.5, 5),
+                               rng.uniform(4.0, 16.0, 5)])
+        slots = merged.slots(names)
+        xyva, marks, kept, on_deck = contact_step(num, slots, merged.arrays, back, owner, side, wander, axis,
+                                                  settings)
+        record_fronts(num, slots, separate.arrays, STEP)
+        x, y, v, a, keep = axles_on_path(num, slots, separate.arrays, back, owner, axis, deck_y,
+                                         (-reach, length + reach), (0.0, length, beside))
+        h = np.radians(num[:, 2])
+        ahead = np.where(np.sin(h) * along[0] + np.cos(h) * along[1] >= 0.0, 1.0, -1.0)
+        y = y + ahead[owner] * side + wander
+        front = (num[:, 0] - axis.origin[0]) * along[0] + (num[:, 1] - axis.origin[1]) * along[1]
+        forward = np.sin(h) * along[0] + np.cos(h) * along[1]
+        rear = front - num[:, 5] * forward
+        gone = ((forward > 0) & (np.minimum(front, rear) > length + reach)) | \
+            ((forward < 0) & (np.maximum(front, rear) < -reach))
+        assert np.array_equal(xyva, np.vstack([x, y, v, a]))
+        assert marks.tolist() == keep.tolist() + gone.tolist()
+        assert kept == keep.sum() and on_deck == bool(((x >= 0.0) & (x <= length)).any())
+    assert 0 < kept < owner.size and gone.any() and not gone.all()  # the draw covers kept, dropped and gone
+    # Without sideways offsets or wander (empty arrays) y is axles_on_path's own.
+    xyva, _, _, _ = contact_step(num, slots, merged.arrays, back, owner, np.zeros(0), np.zeros(0), axis, settings)
+    record_fronts(num, slots, separate.arrays, STEP)
+    _, y, _, _, _ = axles_on_path(num, slots, separate.arrays, back, owner, axis, deck_y, (-reach, length + reach),
+                                  (0.0, length, beside))
+    assert np.array_equal(xyva[1], y)
 
 
 def test_on_a_straight_road_the_axles_stand_exactly_where_the_straight_rule_puts_them() -> None:
