@@ -20,7 +20,7 @@ import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -412,9 +412,11 @@ class ScriptedTraffic(TrafficSource):
         return latest
 
 
-@dataclass(frozen=True)
-class Frame:
+class Frame(NamedTuple):
     """Vehicles near the deck at one traffic-simulation step (bridge coordinates).
+
+    A named tuple, not a frozen dataclass: one is made per SUMO step on each side of a process boundary, and a
+    frozen dataclass of eight fields cost 4.4 us to make against 0.5 us.
 
     Attributes:
         t: time, s (simulation time of the co-simulation, from 0).
