@@ -592,7 +592,8 @@ class FixedTemplate:
                                                                        LARGEST_DRAWN), rounded) + 0.0)
             else:
                 n = min(max(int(x), 0), (1 << 35) - 1)
-                args.append(bytes(((n >> 7 * k) & 0x7F) | 0x80 for k in range(4)) + bytes([(n >> 28) & 0x7F]))
+                args.append(((n & 0x7F | 0x80) | (n >> 7 & 0x7F | 0x80) << 8 | (n >> 14 & 0x7F | 0x80) << 16
+                             | (n >> 21 & 0x7F | 0x80) << 24 | (n >> 28 & 0x7F) << 32).to_bytes(5, "little"))
         args.append(self._pieces[-1])
         return self._row.pack(*args)
 

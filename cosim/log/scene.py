@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -479,10 +479,17 @@ class SceneWriter:
                 groups.setdefault(vehicle_of(contact), []).append(j)
             heavy = {owner: len(cols) > 1 or max(report.models[j].total_mass for j in cols) > HEAVY_KG
                      for owner, cols in groups.items()}
-        if vehicles:
             stamp_of = list(zip(seconds.tolist(), nanoseconds.tolist()))
-            scenes = [b"".join([scene, *self._vehicles(stamp_of[i], report, k, groups, heavy, x[i], near[i], z[i])])
-                      for i, (k, scene) in enumerate(zip(rows, scenes))]
+            names = {owner: proto.length_delimited(3, f"vehicle {owner}".encode()) for owner in groups}  # entity ids
+            y_list: list[float] = np.asarray(report.y, dtype=float).tolist()
+            forces: list[list[float]] = report.contact_force[rows].tolist()
+            on_deck: list[list[bool]] = report.on_deck[rows].tolist()
+            x_rows: list[list[float]] = x.tolist()
+            z_rows = cast(list[list[float]], z.tolist())  # numpy's stubs say a float
+            near_rows: list[list[bool]] = near.tolist()
+            scenes = [b"".join([scene, *self._vehicles(stamp_of[i], y_list, forces[i], on_deck[i], groups, heavy,
+                                                       names, x_rows[i], near_rows[i], z_rows[i])])
+                      for i, scene in enumerate(scenes)]
         self.rec.write_encoded(TOPIC_SCENE, times, scenes)
 
     def _vehicle_template(self, big: bool, axles: int, arrows: tuple[int, ...]) -> proto.FixedTemplate:
@@ -509,37 +516,41 @@ class SceneWriter:
                                                                           value)
         return template
 
-    def _vehicles(self, stamp: tuple[int, int], report: Any, k: int, groups: dict[str, list[int]],
-                  heavy: dict[str, bool], x_all: np.ndarray, near: np.ndarray, z_all: np.ndarray) -> list[bytes]:
-        """A box over each vehicle's axles, its wheels (axles) and its contact forces as arrows, at step ``k`` of
-        the block (time ``stamp``: s, ns), as encoded entities. ``groups``: each vehicle's contact columns;
-        ``x_all``, ``z_all``: the contact points' x and drawn deck level, m; ``near``: on or near the deck."""
-        plan = self.plan
-        y_all = report.y
-        forces = report.contact_force[k]
-        on_deck = report.on_deck[k]
+    def _vehicles(self, stamp: tuple[int, int], y_all: list[float], forces: list[float], on_deck: list[bool],
+                  groups: dict[str, list[int]], heavy: dict[str, bool], names: dict[str, bytes], x_all: list[float],
+                  near: list[bool], z_all: list[float]) -> list[bytes]:
+        """A box over each vehicle's axles, its wheels (axles) and its contact forces as arrows, at one scene
+        (time ``stamp``: s, ns), as encoded entities. ``groups``: each vehicle's contact columns; per contact
+        point: ``y_all``, ``x_all`` and ``z_all`` its lateral offset, x and drawn deck level, m, ``forces`` its
+        contact force (N), ``on_deck`` and ``near`` whether on or near the deck; ``names``: each vehicle's
+        entity id, encoded. Python lists, not arrays: at 10 scenes a second, numpy's per-element access was a
+        good part of the scene's cost (and arrays over the few vehicles of a scene cost more than they save)."""
+        newton_per_m = self.plan.newton_per_m
+        longest = 4.0 * ARROW_LENGTH
         sec, nsec = stamp
         out = []
         for owner, cols in groups.items():
             cols = [j for j in cols if near[j]]
             if not cols:
                 continue
-            xs = [float(x_all[j]) for j in cols]
-            zs = [float(z_all[j]) for j in cols]
+            xs = [x_all[j] for j in cols]
+            zs = [z_all[j] for j in cols]
             big = heavy[owner]
             width, height, wheel = _body(big)
             overhang = 1.5 if len(cols) > 1 else (5.0 if big else 2.25)
             front, back = max(xs) + overhang, min(xs) - overhang
-            y = sum(float(y_all[j]) for j in cols) / len(cols)
+            y = sum(y_all[j] for j in cols) / len(cols)
             z0 = sum(zs) / len(cols)
-            numbers: list[Any] = [sec, nsec, _c((front + back) / 2), _c(y), _c(z0 + wheel * 0.6 + height / 2),
+            cy = _c(y)
+            numbers: list[Any] = [sec, nsec, _c((front + back) / 2), cy, _c(z0 + wheel * 0.6 + height / 2),
                                   _c(front - back)]
+            half = wheel / 2
             for x, z in zip(xs, zs):
-                numbers += (_c(x), _c(y), _c(z + wheel / 2))
+                numbers += (_c(x), cy, _c(z + half))
             arrows = []
             for j, x, z in zip(cols, xs, zs):
-                force = float(forces[j])
-                length = min(abs(force) / plan.newton_per_m, 4.0 * ARROW_LENGTH)
+                force = forces[j]
+                length = min(abs(force) / newton_per_m, longest)
                 if not on_deck[j] or length < 0.05:
                     arrows.append(0)
                     continue
@@ -548,6 +559,6 @@ class SceneWriter:
                 # Beside the body (on its right), where the box does not hide it, down to the deck.
                 numbers += (_c(x), _c(y - width / 2 - 0.4), _c(z + (length if force > 0 else 0.0)),
                             round(length - head, _DECIMALS), round(head, _DECIMALS))
-            body = self._vehicle_template(big, len(cols), tuple(arrows)).row(numbers)
-            out.append(proto.length_delimited(2, body + proto.length_delimited(3, f"vehicle {owner}".encode())))
+            body = self._vehicle_template(big, len(cols), tuple(arrows)).row(numbers) + names[owner]
+            out.append(proto.length_delimited(2, body))
         return out
