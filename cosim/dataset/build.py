@@ -24,6 +24,7 @@ import numpy as np
 
 from cosim.core.bridge import build_bridge
 from cosim.core.section import Material
+from cosim.core.traffic import vehicle_of
 from cosim.errors import ConfigError
 from cosim.log import sensor_series
 from cosim.run.logged import run_logged
@@ -151,7 +152,9 @@ def write_dataset(dataset: Dataset, *, force: bool = False,
                     case.dof if case.support is not None else None, "support_spring": case.spring,
                 "seed": dataset.seed + k, "time_of_day": seconds % 86400.0, "temperature": temperature,
                 "e_factor": e_factor, "f1_hz": _first_vertical_hz(bridge), "duration": outcome.duration,
-                "vehicles": len(outcome.result.vehicle_ids), "max_on_deck": outcome.result.max_on_deck,
+                # Vehicles, not contact points ("id#0", "id#1", ... for a vehicle's own axles), as a study counts.
+                "vehicles": len({vehicle_of(c) for c in outcome.result.vehicle_ids}),
+                "max_on_deck": outcome.result.max_on_deck,
                 "log": str(log.relative_to(dataset.output)),
                 "vehicle_loads": _vehicle_loads(log),
             }
