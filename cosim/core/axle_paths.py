@@ -12,7 +12,8 @@ the road while its rear axles are still on their lane on the deck.
 :class:`AxleTrails` keeps, per followed vehicle, a trail of bumper
 positions with the distance driven at each (``s``, m) in
 fixed arrays that one compiled pass appends to (:func:`record_fronts`) and
-one compiled pass reads (:func:`axles_on_path`). The distance driven between
+one compiled pass reads (:func:`axles_on_path`); a traffic adapter runs both,
+with each contact point's offsets, in one call per step (:func:`contact_step`). The distance driven between
 two steps is the bumper's move, but never more than the travel its speeds
 give (SUMO's ballistic update: the mean speed times the step), so that an
 instant lane change's sideways jump adds no distance. (SUMO's heading is the
