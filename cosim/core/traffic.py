@@ -416,7 +416,7 @@ class Frame(NamedTuple):
     """Vehicles near the deck at one traffic-simulation step (bridge coordinates).
 
     A named tuple, not a frozen dataclass: one is made per SUMO step on each side of a process boundary, and a
-    frozen dataclass of eight fields cost 4.4 us to make against 0.5 us.
+    frozen dataclass of eight fields cost 4.4 us to make, this 1.2 us (by keywords).
 
     Attributes:
         t: time, s (simulation time of the co-simulation, from 0).

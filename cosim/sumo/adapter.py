@@ -606,8 +606,8 @@ class SumoTraffic(LiveSumo):
             loads = self._entering(ids, layout.vehicle_types, num, owner, x, y)
             if loads:
                 layout.unrecorded = any(vid not in self._recorded for vid in ids)
-        # Vehicles gone for good are dropped every few steps (not at once: same frames as when this took numpy
-        # operations at every step, and a late drop only reads a far vehicle a while longer).
+        # Vehicles gone for good are dropped every few steps, at the steps they were before contact_step found them
+        # at every one (the same layouts and slots as then); a late drop only reads a far vehicle a while longer.
         axle_ids, axle_types = layout.ids, layout.types
         if self.sumo_steps % DROP_DEPARTED_EVERY == 0 and marks[len(axle_ids):].any():
             self._drop_departed(ids, marks[len(axle_ids):])
