@@ -140,7 +140,6 @@ class AxleTrails:
         self.s[k, :n] = -np.asarray(behind[-n:], dtype=float)
         self.head[k], self.count[k], self.speed[k] = n - 1, n, speed
 
-
     def slots(self, vehicles: Sequence[str]) -> npt.NDArray[np.int64]:
         """The slot of each vehicle (all added)."""
         return np.array([self.slot_of[v] for v in vehicles], dtype=np.int64)
@@ -284,8 +283,8 @@ def contact_settings(deck_y: tuple[float, float], reach: float, length: float, b
     """What :func:`contact_step` takes of a run, as one array: the region in which it keeps contact points
     (bridge coordinates, m: the deck's width ``deck_y`` within ``reach`` before and after the deck, ``length``
     long, or up to ``beside`` beyond the width over the deck's length: :func:`axles_on_path`'s ``y_range``,
-    ``x_range`` and ``span``), the deck's length and the traffic step (s)."""
-    return np.array([deck_y[0], deck_y[1], -reach, length + reach, 0.0, length, beside, length, step], dtype=float)
+    ``x_range`` and ``span``: the span is the deck's length) and the traffic step (s)."""
+    return np.array([deck_y[0], deck_y[1], -reach, length + reach, 0.0, length, beside, step], dtype=float)
 
 
 def contact_step(vehicles: np.ndarray, slots: np.ndarray, trails: TrailArrays, back: np.ndarray, owner: np.ndarray,
@@ -318,7 +317,7 @@ def _contact_step(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
                   head: np.ndarray, count: np.ndarray, speed: np.ndarray, back: np.ndarray, owner: np.ndarray,
                   left: np.ndarray, wander: np.ndarray, origin: np.ndarray, along: np.ndarray,
                   left_of_axis: np.ndarray, settings: np.ndarray) -> tuple[np.ndarray, np.ndarray, int, bool]:
-    _record_fronts(vehicles, slots, px, py, s, head, count, speed, settings[8])
+    _record_fronts(vehicles, slots, px, py, s, head, count, speed, settings[7])
     x, y, v, a, keep = _axles_on_path(vehicles, slots, px, py, s, head, count, back, owner, origin, along,
                                       left_of_axis, settings[0], settings[1], settings[2], settings[3],
                                       settings[4], settings[5], settings[6])
@@ -340,7 +339,7 @@ def _contact_step(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
         marks[i] = keep[i]
         if keep[i]:
             kept += 1
-        if 0.0 <= x[i] <= settings[7]:
+        if 0.0 <= x[i] <= settings[5]:  # on the deck's length (the span's end)
             on_deck = True
     for r in range(n):
         heading = vehicles[r, 2] * (math.pi / 180.0)

@@ -516,7 +516,7 @@ class SumoTraffic(LiveSumo):
         subscriptions cost more inside each step than the getters they replace: benchmarks/results/profile.md)."""
         self._watched_lanes.update(watched_lanes(net, self.deck_lanes, self.reach))
         self.lanes = tuple(self._watched_lanes)
-        # The contact points kept (axles_on_path's region, bridge coordinates, m): on the deck's width within the
+        # The contact points kept (contact_step's region, bridge coordinates, m): on the deck's width within the
         # reach along it, or beside the width over the deck's length (a bridge placed by its axis alone).
         beside = 0.0 if self.settings.edges else BESIDE_DECK
         self._contact_settings = contact_settings(self.deck_y, self.reach, self.axis.length, beside, self.step)
