@@ -429,16 +429,18 @@ def _stop_runs(client: Any, futures: list[Any], stop: Path, guard: StopGuard,
     Runs that completed meanwhile are handed to ``finished``. A second signal
     while waiting stops the waiting.
     """
+    # Which runs are in progress, asked before the stop file exists: a run that sees the file can end before
+    # the scheduler answers, and it would then be neither waited for nor kept (its row lost).
+    try:
+        assigned = {key for keys in client.processing().values() for key in keys}
+    except Exception:  # noqa: BLE001 - the scheduler is gone: nothing to wait for
+        assigned = set()
     try:
         stop.write_text(guard.held.name if guard.held else "SIGTERM", encoding="utf-8")
     except OSError:
         client.cancel(futures)
         return
     try:
-        try:
-            assigned = {key for keys in client.processing().values() for key in keys}
-        except Exception:  # noqa: BLE001 - the scheduler is gone: nothing to wait for
-            assigned = set()
         client.cancel([f for f in futures if str(f.key) not in assigned and not f.done()])
         running = [f for f in futures if str(f.key) in assigned]
         deadline = time.monotonic() + STOP_WAIT
