@@ -38,12 +38,12 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -76,6 +76,33 @@ DROP_DEPARTED_EVERY = 20
 BESIDE_DECK = 3.75
 #: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
 _BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
+
+
+class _SumoReads(NamedTuple):
+    """The libsumo getters the adapter calls at every step, for every watched lane and followed vehicle.
+
+    Why not ``libsumo.vehicle.getPosition`` and its kind: each is a Python function that calls the SWIG
+    extension's function of the same name (``_libsumo.vehicle_getPosition``); calling those directly saves
+    that layer, about 0.1 us a call and 40 calls a step (benchmarks/results/profile.md). A libsumo without
+    them (another build) is read through its public getters.
+    """
+
+    lane_vehicles: Callable[[str], tuple[str, ...]]
+    position: Callable[[str], tuple[float, float]]
+    angle: Callable[[str], float]
+    speed: Callable[[str], float]
+    acceleration: Callable[[str], float]
+
+    @classmethod
+    def of(cls, libsumo: Any) -> _SumoReads:
+        public = (libsumo.lane.getLastStepVehicleIDs, libsumo.vehicle.getPosition, libsumo.vehicle.getAngle,
+                  libsumo.vehicle.getSpeed, libsumo.vehicle.getAcceleration)
+        raw = getattr(libsumo, "_libsumo", None)
+        names = ("lane_getLastStepVehicleIDs", "vehicle_getPosition", "vehicle_getAngle", "vehicle_getSpeed",
+                 "vehicle_getAcceleration")
+        if raw is None or not all(callable(getattr(raw, name, None)) for name in names):
+            return cls(*public)
+        return cls(*(getattr(raw, name) for name in names))
 
 
 def bundled_networks() -> Path:
@@ -367,6 +394,7 @@ class SumoTraffic(LiveSumo):
         self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
         self._fixed: dict[str, tuple[str, float]] = {}  # each followed vehicle's SUMO type and length, m
         self._layout: _AxleLayout | None = None  # the contact points of the vehicles followed at the last step
+        self._read: _SumoReads | None = None  # libsumo's getters read at every step (once started)
 
     @property
     def half_width(self) -> float:
@@ -400,6 +428,7 @@ class SumoTraffic(LiveSumo):
             *self.settings.extra_args,
         ]
         self.libsumo = libsumo
+        self._read = _SumoReads.of(libsumo)
         try:
             with _captured_output(self._scratch / "console.txt"):
                 libsumo.start(cmd)
@@ -573,7 +602,9 @@ class SumoTraffic(LiveSumo):
                 from None
         self.sumo_steps += 1
         t = self.sumo_steps * self.step
-        present = set(itertools.chain.from_iterable(map(ls.lane.getLastStepVehicleIDs, self.lanes)))
+        read = self._read
+        assert read is not None
+        present = set(itertools.chain.from_iterable(map(read.lane_vehicles, self.lanes)))
         self._done &= present  # a vehicle that left the watched lanes is forgotten
         present -= self._done
         veh = ls.vehicle
@@ -588,7 +619,7 @@ class SumoTraffic(LiveSumo):
         if not present:
             return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
         ids = tuple(sorted(present))
-        position, angle, speed, acceleration = veh.getPosition, veh.getAngle, veh.getSpeed, veh.getAcceleration
+        position, angle, speed, acceleration = read.position, read.angle, read.speed, read.acceleration
         num = np.array([(*position(vid), angle(vid), speed(vid), acceleration(vid), fixed[vid][1]) for vid in ids],
                        dtype=float)
         layout = self._layout
