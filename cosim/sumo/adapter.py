@@ -715,8 +715,18 @@ class SumoTraffic(LiveSumo):
         self._label[vid] = (draw.vehicle_class, draw.wander, draw.source)
 
     def _own_type(self, vid: str, own: VehicleType) -> None:
-        """A vehicle with a vehicle type of its own (its own axles and loads)."""
-        columns = own.contact_columns()
+        """A vehicle with a vehicle type of its own (its own axles and loads).
+
+        A vehicle seen again after it left the watched lanes (a bus crossing back the other way) draws again,
+        for the direction it now drives; the models of its first crossing are still in the tables that the
+        frames' consumers keep under its type's name, so a different draw takes a name of its own
+        (``type@vehicle/2``), not the first one's models.
+        """
+        columns, drawn, again = own.contact_columns(), own, 1
+        while any(key in self._models and self._models[key] != model for key, model, _, _ in columns):
+            again += 1
+            own = replace(drawn, id=f"{drawn.id}/{again}")
+            columns = own.contact_columns()
         self._axles[own.id] = tuple((back, left) for _, _, back, left in columns)
         if any(left for _, left in self._axles[own.id]):
             self._sideways.add(own.id)
