@@ -423,3 +423,20 @@ def test_blocks_of_one_fleet_joined_give_the_same_numbers_to_the_bit(dt):
         np.testing.assert_array_equal(joined.sensors[name], separate.sensors[name])
     for key in ("contact_force", "body_acceleration"):
         np.testing.assert_array_equal(joined.vehicle_table[key], separate.vehicle_table[key])
+
+
+def test_the_adapter_reads_through_libsumos_extension_and_falls_back_to_its_public_getters():
+    import types
+
+    import libsumo
+
+    from cosim.sumo.adapter import _SumoReads
+
+    # libsumo's wrappers are one-line calls of the SWIG functions of the same names (libsumo/__init__.py).
+    direct = _SumoReads.of(libsumo)
+    assert direct.position is libsumo._libsumo.vehicle_getPosition
+    assert direct.lane_vehicles is libsumo._libsumo.lane_getLastStepVehicleIDs
+    without = types.SimpleNamespace(lane=libsumo.lane, vehicle=libsumo.vehicle)  # a build without _libsumo
+    public = _SumoReads.of(without)
+    assert public == (libsumo.lane.getLastStepVehicleIDs, libsumo.vehicle.getPosition, libsumo.vehicle.getAngle,
+                      libsumo.vehicle.getSpeed, libsumo.vehicle.getAcceleration)
