@@ -148,7 +148,8 @@ def _sumo_vehicle_lines(o: LogOverview, deck: DeckVehicles) -> list[str]:
             types = json.loads(raw)
             rows = [f"  {t['type']} ({t['vclass']}): {t['model']}, {float(t['mass']):.0f} kg ({t['sources']['mass']}), "
                     f"{len(t['axles'])} axle(s) ({t['sources']['axles']})" for t in types]
-            lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows]
+            lines += [f"Vehicle types ({len(types)}), from {VEHICLE_TYPES_ATTACHMENT}:", *rows] if rows else \
+                [f"Vehicle types: none in the SUMO config's files ({VEHICLE_TYPES_ATTACHMENT})"]
         except (ValueError, KeyError, TypeError):
             lines.append(f"Vehicle types: {VEHICLE_TYPES_ATTACHMENT} is malformed")
     return lines

@@ -117,6 +117,10 @@ def _sumo_lines(plan: SumoPlan) -> list[str]:
         if beyond:
             lines.append(f"  {beyond}")
     types = plan.types
+    if not types:  # a config without demand of its own (WIM records inserted into SUMO drive alone)
+        brought = "; the WIM records (above) bring their own" if plan.settings.records is not None else ""
+        lines.append(f"Vehicle types: none (no vehicle, trip or flow in the SUMO config's files){brought}")
+        return lines  # nor anything to draw loads for
     lines.append(f"Vehicle types ({len(types)}): model, gross mass, axles, suspension, and where each came from "
                  "(vType params, SUMO mass, cosim default)")
     width = max([len(t.id) for t in types] + [4])

@@ -124,6 +124,17 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict:
             "loads": {m["id"]: m for m in log.topic(TOPIC_VEHICLE_LOADS)}}
 
 
+def test_the_summary_says_the_config_brings_no_vehicle_types_of_its_own(run: dict) -> None:
+    # The config has no demand (folder_with): no empty "Vehicle types (0)" table.
+    assert "Vehicle types: none (no vehicle, trip or flow in the SUMO config's files); the WIM records (above) " \
+           "bring their own" in run["stdout"]
+    assert "Vehicle types (" not in run["stdout"]
+    info = cosim_cli("info", "run.mcap", cwd=run["folder"])
+    assert info.returncode == 0, info.stderr
+    assert "Vehicle types: none in the SUMO config's files (vehicle-types.json)" in info.stdout
+    assert "Vehicle types (" not in info.stdout
+
+
 def test_every_record_comes_onto_the_deck_once_with_its_recorded_loads(run: dict) -> None:
     assert "each inserted into SUMO upstream of the deck" in run["stdout"]
     loads = run["loads"]
