@@ -38,12 +38,12 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
@@ -54,6 +54,7 @@ from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.loads import LoadSettings, VehicleLoads
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
+from cosim.sumo.reads import SumoReads
 from cosim.sumo.records import RecordFeed, RecordsPlan
 from cosim.sumo.vtypes import LOADS_G, VehicleType, vehicle_type
 
@@ -76,33 +77,6 @@ DROP_DEPARTED_EVERY = 20
 BESIDE_DECK = 3.75
 #: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
 _BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
-
-
-class _SumoReads(NamedTuple):
-    """The libsumo getters the adapter calls at every step, for every watched lane and followed vehicle.
-
-    Why not ``libsumo.vehicle.getPosition`` and its kind: each is a Python function that calls the SWIG
-    extension's function of the same name (``_libsumo.vehicle_getPosition``); calling those directly saves
-    that layer, about 0.1 us a call and 40 calls a step (benchmarks/results/profile.md). A libsumo without
-    them (another build) is read through its public getters.
-    """
-
-    lane_vehicles: Callable[[str], tuple[str, ...]]
-    position: Callable[[str], tuple[float, float]]
-    angle: Callable[[str], float]
-    speed: Callable[[str], float]
-    acceleration: Callable[[str], float]
-
-    @classmethod
-    def of(cls, libsumo: Any) -> _SumoReads:
-        public = (libsumo.lane.getLastStepVehicleIDs, libsumo.vehicle.getPosition, libsumo.vehicle.getAngle,
-                  libsumo.vehicle.getSpeed, libsumo.vehicle.getAcceleration)
-        raw = getattr(libsumo, "_libsumo", None)
-        names = ("lane_getLastStepVehicleIDs", "vehicle_getPosition", "vehicle_getAngle", "vehicle_getSpeed",
-                 "vehicle_getAcceleration")
-        if raw is None or not all(callable(getattr(raw, name, None)) for name in names):
-            return cls(*public)
-        return cls(*(getattr(raw, name) for name in names))
 
 
 def bundled_networks() -> Path:
@@ -394,7 +368,7 @@ class SumoTraffic(LiveSumo):
         self._done: set[str] = set()  # on a watched lane, but past the deck for good: not followed
         self._fixed: dict[str, tuple[str, float]] = {}  # each followed vehicle's SUMO type and length, m
         self._layout: _AxleLayout | None = None  # the contact points of the vehicles followed at the last step
-        self._read: _SumoReads | None = None  # libsumo's getters read at every step (once started)
+        self._read: SumoReads | None = None  # libsumo's getters read at every step (once started)
 
     @property
     def half_width(self) -> float:
@@ -428,7 +402,7 @@ class SumoTraffic(LiveSumo):
             *self.settings.extra_args,
         ]
         self.libsumo = libsumo
-        self._read = _SumoReads.of(libsumo)
+        self._read = SumoReads.of(libsumo)
         try:
             with _captured_output(self._scratch / "console.txt"):
                 libsumo.start(cmd)

@@ -430,13 +430,13 @@ def test_the_adapter_reads_through_libsumos_extension_and_falls_back_to_its_publ
 
     import libsumo
 
-    from cosim.sumo.adapter import _SumoReads
+    from cosim.sumo.reads import SumoReads
 
     # libsumo's wrappers are one-line calls of the SWIG functions of the same names (libsumo/__init__.py).
-    direct = _SumoReads.of(libsumo)
+    direct = SumoReads.of(libsumo)
     assert direct.position is libsumo._libsumo.vehicle_getPosition
     assert direct.lane_vehicles is libsumo._libsumo.lane_getLastStepVehicleIDs
     without = types.SimpleNamespace(lane=libsumo.lane, vehicle=libsumo.vehicle)  # a build without _libsumo
-    public = _SumoReads.of(without)
+    public = SumoReads.of(without)
     assert public == (libsumo.lane.getLastStepVehicleIDs, libsumo.vehicle.getPosition, libsumo.vehicle.getAngle,
                       libsumo.vehicle.getSpeed, libsumo.vehicle.getAcceleration)

@@ -242,6 +242,7 @@ PUBLIC_UNDERSCORE = {"_replace", "_asdict", "_fields", "_make", "_field_defaults
 ISOLATED_PRIVATE_READS = {
     ("cosim/core/jit.py", "_locator_classes"),  # numba's cache locators, extended with cosim's
     ("cosim/core/jit.py", "_CacheImpl"),  # numba.core.caching's CacheImpl before numba 0.61
+    ("cosim/sumo/reads.py", "_libsumo"),  # libsumo's SWIG functions, its public getters when a build lacks them
 }
 
 
