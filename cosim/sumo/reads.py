@@ -12,7 +12,7 @@ class SumoReads(NamedTuple):
 
     Why not ``libsumo.vehicle.getPosition`` and its kind: each is a Python function that calls the SWIG
     extension's function of the same name (``_libsumo.vehicle_getPosition``); calling those directly saves
-    that layer, about 0.1 us a call and 40 calls a step (benchmarks/results/profile.md). A libsumo without
+    that layer, about 0.1 us a call and 40 calls a step (benchmarks/README.md, "Where the time goes"). A libsumo without
     them (another build) is read through its public getters.
     """
 

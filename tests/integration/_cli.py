@@ -147,3 +147,10 @@ def broken_sumo_configs(folder: Path) -> tuple[Path, Path]:
     unknown.write_text('<configuration><input><net-file value="bridge.net.xml"/><route-files value="bad.rou.xml"/>'
                        '</input></configuration>')
     return broken, unknown
+
+
+def netconvert() -> str:
+    """SUMO's netconvert, from the eclipse-sumo package (a dependency), for networks built at test time."""
+    import sumo
+
+    return str(Path(sumo.SUMO_HOME) / "bin" / "netconvert")

@@ -10,9 +10,9 @@ than the first named models that did not exist). Built with SUMO's netconvert at
 from __future__ import annotations
 
 import subprocess
-from pathlib import Path
 
 import pytest
+from _cli import netconvert
 
 from cosim.core.vehicles.registry import model_from_dict
 from cosim.log import read_log
@@ -82,18 +82,13 @@ dt = 0.01
 """
 
 
-def _netconvert() -> str:
-    import sumo  # the eclipse-sumo package (a dependency), which ships netconvert
-
-    return str(Path(sumo.SUMO_HOME) / "bin" / "netconvert")
-
 
 @pytest.fixture(scope="module")
 def crossings(tmp_path_factory):
     folder = tmp_path_factory.mktemp("seen-again")
     (folder / "uturn.nod.xml").write_text(NODES)
     (folder / "uturn.edg.xml").write_text(EDGES)
-    subprocess.run([_netconvert(), "--node-files", "uturn.nod.xml", "--edge-files", "uturn.edg.xml",
+    subprocess.run([netconvert(), "--node-files", "uturn.nod.xml", "--edge-files", "uturn.edg.xml",
                     "-o", "uturn.net.xml", "--offset.disable-normalization", "true", "--no-warnings", "true"],
                    cwd=folder, check=True, capture_output=True, timeout=60)
     (folder / "uturn.rou.xml").write_text(ROUTES)

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _cli import cosim_cli  # noqa: E402
+from _cli import cosim_cli, netconvert  # noqa: E402
 
 from cosim.cli import main
 from cosim.log import read_log
@@ -108,18 +108,13 @@ VEHICLES = {"lorry1": 5, "lorry2": 5, "lorry3": 5, "lorry4": 5, "bus1": 2, "bus2
 LANE_TOLERANCE = 1e-6  # m: an axle on the deck lies within its lane's width (round-off of the projection)
 
 
-def _netconvert() -> str:
-    import sumo  # the eclipse-sumo package (a dependency), which ships netconvert
-
-    return str(Path(sumo.SUMO_HOME) / "bin" / "netconvert")
-
 
 @pytest.fixture(scope="module")
 def turns(tmp_path_factory):
     folder = tmp_path_factory.mktemp("turns")
     (folder / "turns.nod.xml").write_text(NODES)
     (folder / "turns.edg.xml").write_text(EDGES)
-    subprocess.run([_netconvert(), "--node-files", "turns.nod.xml", "--edge-files", "turns.edg.xml",
+    subprocess.run([netconvert(), "--node-files", "turns.nod.xml", "--edge-files", "turns.edg.xml",
                     "-o", "turns.net.xml", "--offset.disable-normalization", "true", "--no-turnarounds", "true",
                     "--no-warnings", "true"], cwd=folder, check=True, capture_output=True, timeout=60)
     (folder / "turns.rou.xml").write_text(ROUTES)
