@@ -134,7 +134,7 @@ SHOWN_VEHICLES = 20
 def _sumo_vehicle_lines(o: LogOverview, deck: DeckVehicles) -> list[str]:
     """The SUMO vehicles that were on the deck (without ``--verify``: those of the log's start, and the line
     says so) and the vehicle types of the run."""
-    from cosim.sumo.adapter import VEHICLE_TYPES_ATTACHMENT
+    from cosim.sumo.attachments import VEHICLE_TYPES_ATTACHMENT
 
     vehicles = deck.vehicles
     shown = ", ".join(vehicles[:SHOWN_VEHICLES]) + (f", ... ({len(vehicles) - SHOWN_VEHICLES} more)"

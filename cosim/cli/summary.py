@@ -9,8 +9,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from cosim.core.fields import vehicle_of
 from cosim.core.modal_bridge import ModalBridge
-from cosim.core.traffic import vehicle_of
 from cosim.run.api import RunStart
 from cosim.run.logged import LogCutShort, RunFailed, RunInterrupted, RunOutcome
 from cosim.run.scenario import Scenario

@@ -9,6 +9,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+#: Between a vehicle's id and its axle's number in a contact point's id (``"truck7#2"``).
+AXLE_SEPARATOR = "#"
+
+
+def vehicle_of(contact_id: str) -> str:
+    """The vehicle a contact point belongs to: ``"truck7#2"`` (axle 2 of truck7) -> ``"truck7"``."""
+    return contact_id.split(AXLE_SEPARATOR, 1)[0]
+
 
 @dataclass(frozen=True)
 class Field:

@@ -27,10 +27,10 @@ import numpy.typing as npt
 
 from cosim.errors import ConfigError
 
+from .fields import AXLE_SEPARATOR, vehicle_of
 from .jit import compiled
 from .vehicles import VehicleModel, model_classes
 
-AXLE_SEPARATOR = "#"
 #: A load record waits this long (s of traffic time) for its vehicle to come into a block, then is dropped.
 LOAD_RECORD_WAIT = 60.0
 
@@ -43,11 +43,6 @@ def on_deck(x, length):  # noqa: ANN001, ANN201 - scalars or arrays; also compil
     vehicles a block of steps carries.
     """
     return (x >= 0.0) & (x <= length)
-
-
-def vehicle_of(contact_id: str) -> str:
-    """The vehicle a contact point belongs to: ``"truck7#2"`` (axle 2 of truck7) -> ``"truck7"``."""
-    return contact_id.split(AXLE_SEPARATOR, 1)[0]
 
 
 @dataclass(frozen=True)

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from cosim.core.bridge import build_bridge
+from cosim.core.fields import vehicle_of
 from cosim.core.section import Material
-from cosim.core.traffic import vehicle_of
 from cosim.errors import ConfigError
 from cosim.log import sensor_series
 from cosim.run.logged import run_logged

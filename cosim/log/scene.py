@@ -35,8 +35,8 @@ from typing import Any, cast
 import numpy as np
 
 from cosim.core.bridge import BridgeModel, PointLoad
+from cosim.core.fields import vehicle_of
 from cosim.core.sensors import Sensor, sensor_row
-from cosim.core.traffic import vehicle_of
 
 from . import proto
 from .schemas import SCENE_FRAME, TOPIC_SCENE, TOPIC_SCENE_STATIC, TOPIC_SCENE_TRANSFORM, WORLD_FRAME

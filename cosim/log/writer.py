@@ -31,8 +31,7 @@ from mcap.records import MessageIndex, Statistics
 from mcap.writer import CompressionType, Writer
 
 from cosim import __version__
-from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS
-from cosim.core.traffic import vehicle_of
+from cosim.core.fields import VEHICLE_FIELDS, VEHICLE_NUMBERS, vehicle_of
 from cosim.core.vehicles import model_to_dict
 from cosim.errors import LogError, LogWriteError, interruption_message
 

@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from cosim import plots
-from cosim.core.bridge import BridgeModel, ModalResult
 from cosim.errors import CosimError, LogError
 from cosim.log.reader import check_window, iter_messages, open_log
 from cosim.log.records import ReadStats
@@ -26,6 +25,7 @@ from .outputs import atomic_write, check_new_file, check_not_input
 from .units import display_unit
 
 if TYPE_CHECKING:
+    from cosim.core.bridge import BridgeModel, ModalResult
     from cosim.sumo.network import BridgeLocation
 
 #: Points along the bridge at which mode shapes are drawn.

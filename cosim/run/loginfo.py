@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 
-from cosim.core.traffic import vehicle_of
+from cosim.core.fields import vehicle_of
 from cosim.log.reader import LogOverview, iter_messages, open_log
 from cosim.log.records import ReadStats
 from cosim.log.schemas import TOPIC_EVENTS, TOPIC_TRAFFIC

@@ -12,65 +12,43 @@
   files they name (file lists, relative paths, gzip, the demand's vTypes, the
   study's demand edits).
 
-Importing this package does not load libsumo.
+Importing this package loads none of its modules: each name loads its module on first use
+(``cosim info`` reads a SUMO run's log without loading the adapter's compiled kernels), and
+nothing loads libsumo before a simulation starts.
 """
-from cosim.sumo.adapter import WATCH_MARGIN, SumoTraffic, bundled_networks, sumo_binary
-from cosim.sumo.files import (
-    Demand,
-    SumoConfig,
-    SumoSet,
-    VTypeEntry,
-    distribution_ids,
-    read_config,
-    read_demand,
-    read_input,
-    read_sumo_set,
-    set_speed_limit,
-    set_truck_share,
-    set_vehicles_per_hour,
-    split_file_list,
-    sumo_input_files,
-)
-from cosim.sumo.network import BridgeAxis, BridgeCandidate, BridgeLocation, bridge_candidates, locate_bridge
-from cosim.sumo.vtypes import (
-    HEAVY_VCLASSES,
-    PARAM_PREFIX,
-    VehicleType,
-    axles_from_parameters,
-    model_from_parameters,
-    scaled_model,
-    vehicle_type,
-)
+from __future__ import annotations
 
-__all__ = [
-    "HEAVY_VCLASSES",
-    "PARAM_PREFIX",
-    "WATCH_MARGIN",
-    "BridgeAxis",
-    "BridgeCandidate",
-    "BridgeLocation",
-    "Demand",
-    "SumoConfig",
-    "SumoSet",
-    "SumoTraffic",
-    "VTypeEntry",
-    "VehicleType",
-    "axles_from_parameters",
-    "bridge_candidates",
-    "bundled_networks",
-    "distribution_ids",
-    "locate_bridge",
-    "model_from_parameters",
-    "read_config",
-    "read_demand",
-    "read_input",
-    "read_sumo_set",
-    "scaled_model",
-    "set_speed_limit",
-    "set_truck_share",
-    "set_vehicles_per_hour",
-    "split_file_list",
-    "sumo_binary",
-    "sumo_input_files",
-    "vehicle_type",
-]
+import importlib
+from typing import Any
+
+#: Public name -> the module that defines it.
+_EXPORTS: dict[str, str] = {
+    "WATCH_MARGIN": "cosim.sumo.adapter", "SumoTraffic": "cosim.sumo.adapter",
+    "bundled_networks": "cosim.sumo.adapter", "sumo_binary": "cosim.sumo.adapter",
+    "Demand": "cosim.sumo.files", "SumoConfig": "cosim.sumo.files", "SumoSet": "cosim.sumo.files",
+    "VTypeEntry": "cosim.sumo.files", "distribution_ids": "cosim.sumo.files", "read_config": "cosim.sumo.files",
+    "read_demand": "cosim.sumo.files", "read_input": "cosim.sumo.files", "read_sumo_set": "cosim.sumo.files",
+    "set_speed_limit": "cosim.sumo.files", "set_truck_share": "cosim.sumo.files",
+    "set_vehicles_per_hour": "cosim.sumo.files", "split_file_list": "cosim.sumo.files",
+    "sumo_input_files": "cosim.sumo.files",
+    "BridgeAxis": "cosim.sumo.network", "BridgeCandidate": "cosim.sumo.network",
+    "BridgeLocation": "cosim.sumo.network", "bridge_candidates": "cosim.sumo.network",
+    "locate_bridge": "cosim.sumo.network",
+    "HEAVY_VCLASSES": "cosim.sumo.vtypes", "PARAM_PREFIX": "cosim.sumo.vtypes", "VehicleType": "cosim.sumo.vtypes",
+    "axles_from_parameters": "cosim.sumo.vtypes", "model_from_parameters": "cosim.sumo.vtypes",
+    "scaled_model": "cosim.sumo.vtypes", "vehicle_type": "cosim.sumo.vtypes",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(importlib.import_module(_EXPORTS[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cosim.sumo' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))

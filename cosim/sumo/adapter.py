@@ -51,6 +51,7 @@ from cosim.core.axle_paths import AxisFrame, AxleTrails, contact_settings, conta
 from cosim.core.traffic import Frame, FramedSource, FrameSink, FrameTraffic, LoadRecord, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
+from cosim.sumo.attachments import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
 from cosim.sumo.loads import LoadSettings, VehicleLoads
 from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
@@ -63,10 +64,6 @@ __all__ = ["MESSAGES_FILE", "VEHICLE_TYPES_ATTACHMENT", "WATCH_MARGIN", "BridgeA
 
 #: The least reach of the watched lanes beyond the deck ends, m (the longest vehicle plus slack if longer).
 WATCH_MARGIN = 12.0
-#: SUMO's messages (its log, warnings and errors) in the scratch folder, and the log's attachment of them.
-MESSAGES_FILE = "sumo-messages.log"
-#: The log's attachment with the vehicle types of the run (model, mass, axles and their sources).
-VEHICLE_TYPES_ATTACHMENT = "vehicle-types.json"
 _EMPTY = np.zeros(0)
 #: SUMO steps between two looks for vehicles driving away beyond the watched reach (no longer read then).
 DROP_DEPARTED_EVERY = 20
