@@ -29,8 +29,8 @@ run before); ratios come from the same run, so machine speed cancels. Then
 whole processes, as a user runs them (`--skip-whole` leaves them out):
 `cosim run` of the default scenario for the same hours, its log written,
 against a plain libsumo loop over the same config, in turn, ratio pair by
-pair; and start-up: Python's own start, `cosim --help`, and `cosim run` for
-one SUMO step (start-up to the first step, then closing its log); and the
+pair; and start-up: Python's own start, `cosim --help`, `cosim info` of the
+hour's log, and `cosim run` for one SUMO step (start-up to the first step, then closing its log); and the
 log writer's CPU per simulated hour per topic (direct + log with its scene,
 timed as benchmarks/profile_day.py times it). Then,
 in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
@@ -183,9 +183,10 @@ def _timed(cmd: list[str], env: dict[str, str]) -> tuple[float, float]:
 def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str]:
     """`cosim run` of the default scenario for ``hours`` as a user runs it (a whole process, its start-up and
     its log included) against a plain libsumo loop over the same SUMO config, step, end and seed, in turn
-    (A B A B ...: the ratio is taken pair by pair); then start-up: Python's own, `cosim --help`, and `cosim run`
-    of the same scenario for one SUMO step (start-up to the first step, plus closing the log); with ``day_hours``,
-    one `cosim run` of that many hours too (issue 27's day: no 3D scene past an hour, SUMO in its own process)."""
+    (A B A B ...: the ratio is taken pair by pair); then start-up: Python's own, `cosim --help`, `cosim info` of
+    the hour's log, and `cosim run` of the same scenario for one SUMO step (start-up to the first step, plus
+    closing the log); with ``day_hours``, one `cosim run` of that many hours too (issue 27's day: no 3D scene
+    past an hour, SUMO in its own process)."""
     import tomllib
 
     from cosim.run.scenario import load_scenario
@@ -212,16 +213,18 @@ def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str
              str(folder / "first.mcap"), "--force", "--quiet"]
     python = [sys.executable, "-c", "pass"]
     helps = [sys.executable, "-m", "cosim", "--help"]
+    info = [sys.executable, "-m", "cosim", "info", str(folder / "run.mcap")]
     _timed(first, env)  # compiled kernels in numba's cache, modules compiled, the section in its cache
     runs: dict[str, list[tuple[float, float]]] = {"cosim": [], "plain": []}
     for _ in range(reps):
         runs["cosim"].append(_timed(cosim, env))
         runs["plain"].append(_timed(plain, env))
     log_mb = (folder / "run.mcap").stat().st_size / 1e6
-    starts: dict[str, list[float]] = {"python": [], "help": [], "first": []}
+    starts: dict[str, list[float]] = {"python": [], "help": [], "info": [], "first": []}
     for _ in range(5):
         starts["python"].append(_timed(python, env)[0])
         starts["help"].append(_timed(helps, env)[0])
+        starts["info"].append(_timed(info, env)[0])
         starts["first"].append(_timed(first, env)[0])
     day = None
     if day_hours > 0:
@@ -249,6 +252,7 @@ def whole_processes(hours: float, reps: int, day_hours: float = 0.0) -> list[str
         "| process | wall [s] | above Python's own start [s] |", "|---|---|---|",
         f"| `python -c pass` | {py:.2f} | |",
         f"| `cosim --help` | {med(starts['help']):.2f} | {med(starts['help']) - py:.2f} |",
+        f"| `cosim info` of the hour's log | {med(starts['info']):.2f} | {med(starts['info']) - py:.2f} |",
         f"| `cosim run` for one SUMO step (start-up to the first step, then closing the log) | "
         f"{med(starts['first']):.2f} | {med(starts['first']) - py:.2f} |",
     ]

@@ -12,14 +12,17 @@ like any other channel.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from cosim.errors import ConfigError
 
-from .bridge import BridgeModel
 from .checks import finite, one_of
 from .element import DeckRow
+
+if TYPE_CHECKING:  # its module loads scipy, which reading a log's sensors does not need
+    from .bridge import BridgeModel
 
 #: Sensor quantities and their SI units.
 SENSOR_UNITS: dict[str, str] = {

@@ -31,10 +31,11 @@ _EXPORTS: dict[str, str] = {
     "set_speed_limit": "cosim.sumo.files", "set_truck_share": "cosim.sumo.files",
     "set_vehicles_per_hour": "cosim.sumo.files", "split_file_list": "cosim.sumo.files",
     "sumo_input_files": "cosim.sumo.files",
+    "HEAVY_VCLASSES": "cosim.sumo.library",
     "BridgeAxis": "cosim.sumo.network", "BridgeCandidate": "cosim.sumo.network",
     "BridgeLocation": "cosim.sumo.network", "bridge_candidates": "cosim.sumo.network",
     "locate_bridge": "cosim.sumo.network",
-    "HEAVY_VCLASSES": "cosim.sumo.vtypes", "PARAM_PREFIX": "cosim.sumo.vtypes", "VehicleType": "cosim.sumo.vtypes",
+    "PARAM_PREFIX": "cosim.sumo.vtypes", "VehicleType": "cosim.sumo.vtypes",
     "axles_from_parameters": "cosim.sumo.vtypes", "model_from_parameters": "cosim.sumo.vtypes",
     "scaled_model": "cosim.sumo.vtypes", "vehicle_type": "cosim.sumo.vtypes",
 }

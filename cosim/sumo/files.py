@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from cosim.errors import ConfigError
-from cosim.sumo.vtypes import HEAVY_VCLASSES
+from cosim.sumo.library import HEAVY_VCLASSES  # not from vtypes: reading SUMO files needs no vehicle models
 
 __all__ = [
     "DEMAND_OPTIONS",

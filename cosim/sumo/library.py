@@ -32,7 +32,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-__all__ = ["ENTRIES", "FALLBACK", "GOLDEN_CAR", "ROAD_FRIENDLY", "LibraryVehicle", "Suspension", "entry_for"]
+__all__ = ["ENTRIES", "FALLBACK", "GOLDEN_CAR", "HEAVY_VCLASSES", "ROAD_FRIENDLY", "LibraryVehicle", "Suspension",
+           "entry_for"]
+
+#: SUMO vehicle classes that count as trucks (a study's ``truck_share``).
+HEAVY_VCLASSES = ("bus", "coach", "truck", "trailer")
 
 G_FLM4 = 9.81  # m/s^2: FLM4 axle loads (kN) to masses
 

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING
 from cosim.core.vehicles import LIBRARY, MODELS, ModelSpec, TyreQuarterCar, VehicleModel, VTypeInputs
 from cosim.core.vehicles.registry import cell
 from cosim.errors import ConfigError, SumoError
-from cosim.sumo.library import LibraryVehicle, Suspension, entry_for
+from cosim.sumo.library import HEAVY_VCLASSES, LibraryVehicle, Suspension, entry_for
 
 if TYPE_CHECKING:
     from cosim.core.loads import VehicleLoad
@@ -71,8 +71,6 @@ AXLE_KEYS = ("axles", "axle_loads")
 #: ``cosim.model`` when a vType sets suspension params without it.
 DEFAULT_MODEL = "quarter-car"
 CONTACT_KINDS = ("bilateral", "unilateral")
-#: SUMO vehicle classes that count as trucks (a study's ``truck_share``).
-HEAVY_VCLASSES = ("bus", "coach", "truck", "trailer")
 #: Where a number came from, as summaries and logs say it.
 SOURCE_PARAMS = "vType params"
 SOURCE_MASS = "SUMO mass"
