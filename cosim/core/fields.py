@@ -3,7 +3,8 @@
 The log's ``/cosim/vehicles`` schema, the CSV export's columns, the
 in-memory vehicle table of :class:`cosim.core.simulation.SimulationResult`
 and the scenario-testing results all derive from :data:`VEHICLE_FIELDS`;
-adding a field here adds it everywhere.
+adding a field here adds it everywhere. A contact point's id names its vehicle
+and axle (:func:`vehicle_of`); this module loads nothing heavy, so log readers use it.
 """
 from __future__ import annotations
 
