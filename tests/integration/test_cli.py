@@ -61,16 +61,22 @@ HEAVY = ("numpy", "scipy", "numba", "matplotlib", "mcap", "sumolib", "libsumo", 
 def test_help_loads_no_heavy_library(command: str) -> None:
     """``cosim --help`` and ``cosim <command> --help`` build the whole parser and print, loading none of the
     libraries the commands work with (a fresh process: what a user's ``cosim ... --help`` loads)."""
-    code = ("import sys\nfrom cosim.cli import main\n"
-            "status = main([*sys.argv[1:], '--help'])\n"
-            f"loaded = sorted({{name.split('.')[0] for name in sys.modules}} & set({HEAVY!r}))\n"
-            "print('loaded:', loaded, 'status:', status)\n")
-    args = [command] if command else []
-    result = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=REPO,
-                            env=cli_env(), timeout=120)
-    assert result.returncode == 0, result.stderr
+    result = _loading(([command] if command else []) + ["--help"], HEAVY, REPO)
     assert result.stdout.splitlines()[-1] == "loaded: [] status: 0", result.stdout.splitlines()[-1]
     assert (f"usage: cosim {command}" if command else "usage: cosim [-h]") in result.stdout
+
+
+def _loading(argv: list[str], libraries: tuple[str, ...], cwd: Path) -> subprocess.CompletedProcess[str]:
+    """``cosim *argv`` in a fresh process, which prints as its last line which of ``libraries`` it loaded and
+    ``main``'s status."""
+    code = ("import sys\nfrom cosim.cli import main\n"
+            "status = main(sys.argv[1:])\n"
+            f"loaded = sorted({{name.split('.')[0] for name in sys.modules}} & set({libraries!r}))\n"
+            "print('loaded:', loaded, 'status:', status)\n")
+    result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=cwd,
+                            env=cli_env(), timeout=120)
+    assert result.returncode == 0, result.stderr
+    return result
 
 
 #: What reading a log or a SUMO network must not load: the compiled kernels (numba), scipy, SUMO itself, the
@@ -89,13 +95,7 @@ def test_reading_a_log_or_a_network_loads_no_solver_and_no_sumo(argv: list[str],
     ``cosim bridge`` of a network, load neither the numerical core's compiled kernels nor SUMO: ``cosim info``
     loaded numba through the adapter and took 1.4 s instead of 0.3 s, ``cosim bridge`` 1.4 s instead of 0.5 s
     (measured side by side on this machine)."""
-    code = ("import sys\nfrom cosim.cli import main\n"
-            "status = main(sys.argv[1:])\n"
-            f"loaded = sorted({{name.split('.')[0] for name in sys.modules}} & set({NOT_FOR_READING!r}))\n"
-            "print('loaded:', loaded, 'status:', status)\n")
-    result = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=tmp_path,
-                            env=cli_env(), timeout=120)
-    assert result.returncode == 0, result.stderr
+    result = _loading(argv, NOT_FOR_READING, tmp_path)
     assert result.stdout.splitlines()[-1] == "loaded: [] status: 0", result.stdout.splitlines()[-1]
 
 
