@@ -31,9 +31,9 @@ whole processes, as a user runs them (`--skip-whole` leaves them out):
 against a plain libsumo loop over the same config, in turn, ratio pair by
 pair; and start-up: Python's own start, `cosim --help`, `cosim info` of the
 hour's log, and `cosim run` for one SUMO step (start-up to the first step,
-then closing its log); and the log writer's CPU per simulated hour per topic (direct + log with its scene,
-timed as benchmarks/profile_day.py times it). Then,
-in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
+then closing its log); and the log writer's CPU per simulated hour per
+topic (direct + log with its scene, timed as benchmarks/profile_day.py
+times it). Then, in this process: microseconds per step with 0/1/8/16/64 quarter-cars on the
 deck for both bases (benchmarks/bench_step.py's set-up), and OpenSeesPy per
 step with 8 moving forces when it is installed (`pip install '.[bench]'`).
 """
