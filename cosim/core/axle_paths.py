@@ -37,9 +37,11 @@ SUMO's 0.05 s step), R = 12 m (a tight junction turn), b = 14 m.
 """
 from __future__ import annotations
 
+import bisect
 import math
 from collections import namedtuple
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -352,15 +354,63 @@ def _contact_step(vehicles: np.ndarray, slots: np.ndarray, px: np.ndarray, py: n
     return out, marks, kept, on_deck
 
 
-def path_behind(shape: npt.ArrayLike, lane_length: float, position: float, front: npt.ArrayLike,
+class LaneLine(NamedTuple):
+    """A lane's centre line as :func:`path_behind` reads it (:func:`lane_line`): its vertices (m, network), the
+    distance along the line to each (m, from its start), the line's length, the lane's length as the traffic
+    simulation counts it (m; SUMO scales positions on the line by their ratio) and the unit vector of its first
+    segment of nonzero length (zero if none)."""
+
+    x: tuple[float, ...]
+    y: tuple[float, ...]
+    along: tuple[float, ...]
+    total: float
+    lane_length: float
+    start_dir: tuple[float, float]
+
+
+def lane_line(shape: npt.ArrayLike, lane_length: float) -> LaneLine:
+    """A lane's centre line ``shape`` ((n, 2) network coordinates, m; at least two points) with the lane's
+    length as the traffic simulation counts it (m), prepared once per lane for :func:`path_behind`."""
+    pts = np.asarray(shape, dtype=float)[:, :2]
+    seg = np.hypot(*np.diff(pts, axis=0).T)
+    along = np.concatenate([[0.0], np.cumsum(seg)])
+    first = np.flatnonzero(seg > 0.0)
+    start_dir = (0.0, 0.0)
+    if len(first):
+        f = int(first[0])
+        start_dir = (float((pts[f + 1, 0] - pts[f, 0]) / seg[f]), float((pts[f + 1, 1] - pts[f, 1]) / seg[f]))
+    return LaneLine(tuple(pts[:, 0].tolist()), tuple(pts[:, 1].tolist()), tuple(along.tolist()), float(along[-1]),
+                    float(lane_length), start_dir)
+
+
+def _interp(g: float, along: Sequence[float], values: Sequence[float]) -> float:
+    """``np.interp(g, along, values)`` to the bit, for one number (numpy's arr_interp, its steps in order):
+    numpy's call on arrays of a few points cost most of a seeded trail's time, at every vehicle's first sight."""
+    if g != g:
+        return g
+    j = bisect.bisect_right(along, g) - 1  # numpy's search: the last vertex at or before g
+    if j < 0:
+        return values[0]
+    if j >= len(along) - 1:  # at or after the last vertex
+        return values[-1]
+    if along[j] == g:
+        return values[j]
+    slope = (values[j + 1] - values[j]) / (along[j + 1] - along[j])
+    out = slope * (g - along[j]) + values[j]
+    if out != out:
+        out = slope * (g - along[j + 1]) + values[j + 1]
+        if out != out and values[j] == values[j + 1]:
+            out = values[j]
+    return out
+
+
+def path_behind(lane: LaneLine, position: float, front: npt.NDArray[np.float64] | Sequence[float],
                 reach: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """The path behind a bumper along its lane, to seed a trail (:meth:`AxleTrails.seed`).
 
     Args:
-        shape: the lane's centre line, (n, 2) network coordinates, m.
-        lane_length: the lane's length as the traffic simulation counts it, m (it may differ from the
-            centre line's: SUMO scales positions on the line by their ratio).
-        position: the bumper's position on the lane, m from its start (in ``lane_length``'s measure).
+        lane: the lane's centre line (:func:`lane_line`).
+        position: the bumper's position on the lane, m from its start (in the lane's length's measure).
         front: the bumper (network, m): the centre line is moved onto it (a vehicle off its lane's centre).
         reach: how far back the path is wanted, m; before the lane's start it goes on straight, along the
             lane's first segment.
@@ -369,28 +419,26 @@ def path_behind(shape: npt.ArrayLike, lane_length: float, position: float, front
         The points (m, 2), oldest first, the last the bumper, and each one's distance before it along the
         path (m, decreasing to 0).
     """
-    pts = np.asarray(shape, dtype=float)[:, :2]
-    seg = np.hypot(*np.diff(pts, axis=0).T)
-    along = np.concatenate([[0.0], np.cumsum(seg)])
-    total = float(along[-1])
-    g = position * total / lane_length if lane_length > 0 else position
+    px, py, along, total = lane.x, lane.y, lane.along, lane.total
+    g = position * total / lane.lane_length if lane.lane_length > 0 else position
     g = min(max(g, 0.0), total)
-    at = np.array([np.interp(g, along, pts[:, 0]), np.interp(g, along, pts[:, 1])])
-    shift = np.asarray(front, dtype=float)[:2] - at
-    inner = np.flatnonzero((along < g) & (g - along < reach))
-    points = [pts[j] for j in inner]
+    at = (_interp(g, along, px), _interp(g, along, py))
+    fx, fy = float(front[0]), float(front[1])
+    shift = (fx - at[0], fy - at[1])
+    inner = [j for j, s in enumerate(along) if s < g and g - s < reach]
+    points = [(px[j], py[j]) for j in inner]
     behind = [g - along[j] for j in inner]
-    if g - reach <= 0.0 or not len(inner):  # on, straight, before the lane's start (or its first segment)
-        first = np.flatnonzero(seg > 0.0)
-        start_dir = (pts[first[0] + 1] - pts[first[0]]) / seg[first[0]] if len(first) else np.zeros(2)
+    if g - reach <= 0.0 or not inner:  # on, straight, before the lane's start (or its first segment)
         if g >= reach:
-            start = np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])])
+            start = (_interp(g - reach, along, px), _interp(g - reach, along, py))
         else:
-            start = pts[0] - (reach - g) * start_dir
+            start = (px[0] - (reach - g) * lane.start_dir[0], py[0] - (reach - g) * lane.start_dir[1])
         points.insert(0, start)
         behind.insert(0, reach)
     elif along[inner[0]] > g - reach:  # the oldest vertex is within reach: the point at the reach before it
-        points.insert(0, np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])]))
+        points.insert(0, (_interp(g - reach, along, px), _interp(g - reach, along, py)))
         behind.insert(0, reach)
-    out = np.array(points + [at]) + shift
-    return out, np.array(behind + [0.0])
+    points.append(at)
+    out = np.array([(x + shift[0], y + shift[1]) for x, y in points])
+    behind.append(0.0)
+    return out, np.array(behind)

@@ -47,7 +47,15 @@ from typing import Any
 
 import numpy as np
 
-from cosim.core.axle_paths import AxisFrame, AxleTrails, contact_settings, contact_step, path_behind
+from cosim.core.axle_paths import (
+    AxisFrame,
+    AxleTrails,
+    LaneLine,
+    contact_settings,
+    contact_step,
+    lane_line,
+    path_behind,
+)
 from cosim.core.traffic import Frame, FramedSource, FrameSink, FrameTraffic, LoadRecord, TrafficBlock
 from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
@@ -358,7 +366,7 @@ class SumoTraffic(LiveSumo):
         self._label: dict[str, tuple[str, float, str]] = {}  # vehicle -> its class, wander (m), loads' source
         self._recorded: set[str] = set()  # vehicles whose load record went out (at their entry onto the deck)
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
-        self._lane_geometry: dict[str, tuple[np.ndarray, float]] = {}
+        self._lane_geometry: dict[str, LaneLine | None] = {}  # None: a line of fewer than two points
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
         self._scratch: Path | None = None
         self._watched: set[str] = set()
@@ -756,17 +764,17 @@ class SumoTraffic(LiveSumo):
         ls = self.libsumo
         try:
             lane, position = ls.vehicle.getLaneID(vid), ls.vehicle.getLanePosition(vid)
-            geometry = self._lane_geometry.get(lane)
-            if geometry is None:
-                geometry = (np.asarray(ls.lane.getShape(lane), dtype=float), float(ls.lane.getLength(lane)))
-                self._lane_geometry[lane] = geometry
+            if lane not in self._lane_geometry:
+                shape = ls.lane.getShape(lane)
+                self._lane_geometry[lane] = lane_line(shape, float(ls.lane.getLength(lane))) if len(shape) >= 2 \
+                    else None
+            line = self._lane_geometry[lane]
         except Exception:  # noqa: BLE001 - no lane to be had (SUMO's exception types vary): the trail starts here
             return
-        shape, length = geometry
-        if len(shape) < 2:
+        if line is None:
             return
         assert self._trails is not None
-        points, behind = path_behind(shape, length, position, row[:2], self.reach)
+        points, behind = path_behind(line, position, row[:2], self.reach)
         self._trails.seed(vid, points, behind, float(row[3]))
 
     def _drop_departed(self, ids: Sequence[str], gone: np.ndarray) -> None:

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from cosim.core.axle_paths import (
     MIN_SPACING,
@@ -13,6 +15,7 @@ from cosim.core.axle_paths import (
     axles_on_path,
     contact_settings,
     contact_step,
+    lane_line,
     path_behind,
     record_fronts,
     trail_capacity,
@@ -202,7 +205,7 @@ def test_a_seeded_trail_puts_the_axles_on_the_lane_behind_and_straight_before_it
     # behind 2 m before the lane's start, on the straight line of its first segment (x = -2).
     shape = [(0.0, 0.0), (10.0, 0.0), (10.0, 20.0)]
     front = np.array([10.0, 5.0])
-    points, behind = path_behind(shape, 30.0, 15.0, front, 20.0)
+    points, behind = path_behind(lane_line(shape, 30.0), 15.0, front, 20.0)
     assert behind[0] == 20.0 and behind[-1] == 0.0 and np.all(np.diff(behind) < 0)
     np.testing.assert_allclose(points[-1], front)
     trails = AxleTrails(20.0)
@@ -212,9 +215,55 @@ def test_a_seeded_trail_puts_the_axles_on_the_lane_behind_and_straight_before_it
     np.testing.assert_allclose(x, [10.0, 7.0, -2.0], atol=1e-12)
     np.testing.assert_allclose(y, [2.0, 0.0, 0.0], atol=1e-12)
     # A lane whose length differs from its line's (SUMO scales positions): position 15 of 60 m is 7.5 m along.
-    points, behind = path_behind(shape, 60.0, 15.0, np.array([7.5, 0.3]), 4.0)
+    points, behind = path_behind(lane_line(shape, 60.0), 15.0, np.array([7.5, 0.3]), 4.0)
     np.testing.assert_allclose(points, [[3.5, 0.3], [7.5, 0.3]], atol=1e-12)  # moved onto the bumper (0.3 left)
     np.testing.assert_allclose(behind, [4.0, 0.0])
+
+
+def _path_behind_by_numpy(shape: np.ndarray, lane_length: float, position: float, front: np.ndarray,
+                          reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """The seeded path computed with numpy's np.interp on whole arrays (path_behind before it went scalar)."""
+    pts = np.asarray(shape, dtype=float)[:, :2]
+    seg = np.hypot(*np.diff(pts, axis=0).T)
+    along = np.concatenate([[0.0], np.cumsum(seg)])
+    total = float(along[-1])
+    g = min(max(position * total / lane_length if lane_length > 0 else position, 0.0), total)
+    at = np.array([np.interp(g, along, pts[:, 0]), np.interp(g, along, pts[:, 1])])
+    inner = np.flatnonzero((along < g) & (g - along < reach))
+    points, behind = [pts[j] for j in inner], [g - along[j] for j in inner]
+    if g - reach <= 0.0 or not len(inner):
+        first = np.flatnonzero(seg > 0.0)
+        start_dir = (pts[first[0] + 1] - pts[first[0]]) / seg[first[0]] if len(first) else np.zeros(2)
+        start = np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])]) \
+            if g >= reach else pts[0] - (reach - g) * start_dir
+        points.insert(0, start)
+        behind.insert(0, reach)
+    elif along[inner[0]] > g - reach:
+        points.insert(0, np.array([np.interp(g - reach, along, pts[:, 0]), np.interp(g - reach, along, pts[:, 1])]))
+        behind.insert(0, reach)
+    return np.array(points + [at]) + (np.asarray(front, dtype=float)[:2] - at), np.array(behind + [0.0])
+
+
+_COORD = st.floats(-500.0, 500.0, allow_nan=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(vertices=st.lists(st.tuples(_COORD, _COORD), min_size=2, max_size=9), repeat=st.integers(0, 8),
+       scale=st.floats(0.5, 2.0), at=st.floats(-0.2, 1.2), front=st.tuples(_COORD, _COORD),
+       reach=st.floats(0.1, 400.0))
+def test_a_seeded_path_is_numpys_interpolation_to_the_bit(vertices: list[tuple[float, float]], repeat: int,
+                                                          scale: float, at: float, front: tuple[float, float],
+                                                          reach: float) -> None:
+    # Reference: np.interp over whole arrays (_path_behind_by_numpy); a repeated vertex gives a zero-length segment.
+    if repeat < len(vertices):
+        vertices = vertices[:repeat + 1] + vertices[repeat:]
+    shape = np.array(vertices)
+    line_length = float(np.hypot(*np.diff(shape, axis=0).T).sum())
+    lane_length, position = line_length * scale, line_length * scale * at
+    got = path_behind(lane_line(shape, lane_length), position, np.array(front), reach)
+    want = _path_behind_by_numpy(shape, lane_length, position, np.array(front), reach)
+    np.testing.assert_array_equal(got[0], want[0])  # tolerance 0: the same operations in the same order
+    np.testing.assert_array_equal(got[1], want[1])
 
 
 def test_trails_grow_for_longer_vehicles_and_keep_what_they_hold() -> None:
