@@ -727,7 +727,7 @@ class SumoTraffic(LiveSumo):
             if not 0.0 <= xi <= length or vehicles[r] in recorded:
                 continue
             vid = vehicles[r]
-            self._recorded.add(vid)
+            recorded.add(vid)
             vtype = self._own.get(vid) or self.types[types[r]]
             label, offset, source = self._label.get(vid, (vtype.vclass, 0.0, f"vType {vtype.id}: "
                                                                              f"{vtype.sources.get('mass', '')}"))
