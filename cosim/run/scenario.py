@@ -267,7 +267,7 @@ class Scenario(ConfigModel):
         """``[traffic] sumo_config`` resolved (a bundled level, or a file relative to ``base``)."""
         assert self.traffic is not None and self.traffic.sumo_config is not None
         if self.traffic.bundled:
-            from cosim.sumo.adapter import bundled_networks
+            from cosim.sumo.install import bundled_networks
 
             return bundled_networks() / f"{self.traffic.sumo_config}.sumocfg"
         return base / self.traffic.sumo_config

@@ -2,7 +2,7 @@
 
 - :mod:`cosim.sumo.adapter`: :class:`SumoTraffic` drives SUMO through libsumo
   (the only libsumo importer, and only once a simulation starts) and turns its
-  vehicles into frames for the beam; the bundled networks.
+  vehicles into frames for the beam; :mod:`cosim.sumo.install`: the SUMO binary and the bundled networks.
 - :mod:`cosim.sumo.network`: the network around the bridge, read with sumolib:
   :class:`BridgeAxis`, the bridge located from its edges, the lanes to watch,
   candidate bridges.
@@ -24,7 +24,7 @@ from typing import Any
 #: Public name -> the module that defines it.
 _EXPORTS: dict[str, str] = {
     "WATCH_MARGIN": "cosim.sumo.adapter", "SumoTraffic": "cosim.sumo.adapter",
-    "bundled_networks": "cosim.sumo.adapter", "sumo_binary": "cosim.sumo.adapter",
+    "bundled_networks": "cosim.sumo.install", "sumo_binary": "cosim.sumo.install",
     "Demand": "cosim.sumo.files", "SumoConfig": "cosim.sumo.files", "SumoSet": "cosim.sumo.files",
     "VTypeEntry": "cosim.sumo.files", "distribution_ids": "cosim.sumo.files", "read_config": "cosim.sumo.files",
     "read_demand": "cosim.sumo.files", "read_input": "cosim.sumo.files", "read_sumo_set": "cosim.sumo.files",

@@ -36,11 +36,9 @@ import itertools
 import math
 import os
 import shutil
-import sys
 import tempfile
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
@@ -61,8 +59,17 @@ from cosim.core.vehicles import VehicleModel
 from cosim.errors import ConfigError, SumoError, first_line
 from cosim.sumo.attachments import MESSAGES_FILE, VEHICLE_TYPES_ATTACHMENT
 from cosim.sumo.files import Demand, read_demand, read_sumo_set, write_sumo_set
+from cosim.sumo.install import bundled_networks, captured_output, sumo_binary
 from cosim.sumo.loads import LoadSettings, VehicleLoads
-from cosim.sumo.network import REACH_SLACK, BridgeAxis, lanes_across, locate_bridge, net_path, watched_lanes
+from cosim.sumo.network import (
+    REACH_SLACK,
+    BridgeAxis,
+    deck_directions,
+    lanes_across,
+    locate_bridge,
+    net_path,
+    watched_lanes,
+)
 from cosim.sumo.reads import SumoReads
 from cosim.sumo.records import RecordFeed, RecordsPlan
 from cosim.sumo.vtypes import LOADS_G, VehicleType, vehicle_type
@@ -82,47 +89,6 @@ DROP_DEPARTED_EVERY = 20
 BESIDE_DECK = 3.75
 #: SUMO's built-in vTypes that carry no road vehicles (persons, containers, rail).
 _BUILT_IN_OTHER = ("DEFAULT_PEDTYPE", "DEFAULT_CONTAINERTYPE", "DEFAULT_RAILTYPE")
-
-
-def bundled_networks() -> Path:
-    """Folder of the SUMO networks shipped with cosim (sumo_networks/)."""
-    return Path(str(resources.files("sumo_networks")))
-
-
-def sumo_binary() -> str:
-    """The ``sumo`` executable of the eclipse-sumo wheel (for SUMO_HOME and data files)."""
-    try:
-        import sumo  # eclipse-sumo
-
-        return str(Path(sumo.SUMO_HOME) / "bin" / "sumo")
-    except (ImportError, AttributeError):
-        return "sumo"
-
-
-@contextlib.contextmanager
-def _captured_output(into: Path) -> Iterator[None]:
-    """Whatever the process writes on its standard output and error inside the block goes to ``into``.
-
-    SUMO reports a broken config on its standard error before its log exists;
-    libsumo only raises "Process Error". Redirected at the file-descriptor
-    level, since SUMO writes from C++.
-    """
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    saved = [os.dup(1), os.dup(2)]
-    try:
-        with open(into, "ab") as sink:
-            os.dup2(sink.fileno(), 1)
-            os.dup2(sink.fileno(), 2)
-            try:
-                yield
-            finally:
-                os.dup2(saved[0], 1)
-                os.dup2(saved[1], 2)
-    finally:
-        for fd in saved:
-            os.close(fd)
 
 
 @dataclass(frozen=True)
@@ -192,6 +158,7 @@ class LiveSumo(FramedSource):
         self.edges: tuple[str, ...] = ()
         self.lanes: tuple[str, ...] = ()
         self.deck_lanes: tuple[str, ...] = ()
+        self.deck_directions: dict[str, int] = {}  # deck edge -> Grave's direction: 1 along the axis, 2 against
         self.reach = WATCH_MARGIN
         self._models: dict[str, VehicleModel] = {}  # every type known so far (this source's own table)
         self._fresh: dict[str, VehicleModel] = {}  # known since the last frame was handed on
@@ -409,7 +376,7 @@ class SumoTraffic(LiveSumo):
         self.libsumo = libsumo
         self._read = SumoReads.of(libsumo)
         try:
-            with _captured_output(self._scratch / "console.txt"):
+            with captured_output(self._scratch / "console.txt"):
                 libsumo.start(cmd)
         except Exception as exc:  # libsumo raises its own error types; SUMO said why on its console
             self.libsumo = None
@@ -442,7 +409,7 @@ class SumoTraffic(LiveSumo):
             self._feed.close()
         if self.libsumo is not None:
             try:
-                with _captured_output(self._scratch / "console.txt") if self._scratch else contextlib.nullcontext():
+                with captured_output(self._scratch / "console.txt") if self._scratch else contextlib.nullcontext():
                     self.libsumo.close()
             except Exception:  # noqa: BLE001 - closing a failed simulation must not mask the first error
                 pass
@@ -515,6 +482,7 @@ class SumoTraffic(LiveSumo):
                 f"{self.axis.start} -> {self.axis.end}; check [traffic] axis or edges"
             )
         self.deck_lanes = tuple(deck)
+        self.deck_directions = deck_directions(net, self.deck_lanes, self.axis)
         self._watched_lanes: set[str] = set()
         self._watch_lanes(net)
 
@@ -679,8 +647,9 @@ class SumoTraffic(LiveSumo):
     # ----------------------------------------------------------------- loads
     def _first_sight(self, vid: str, vtype: str, row: np.ndarray) -> None:
         """A vehicle seen for the first time: with ``[traffic.loads]``, what it carries (its own vehicle type,
-        class, wander and the loads' source), drawn from the seed and its id; its direction from its heading.
-        A WIM record inserted into SUMO carries its recorded axles (:mod:`cosim.sumo.records`)."""
+        class, wander and the loads' source), drawn from the seed and its id, for the direction it will cross the
+        deck in (:meth:`_crossing_direction`). A WIM record inserted into SUMO carries its recorded axles
+        (:mod:`cosim.sumo.records`)."""
         record = self._feed.live.get(vid) if self._feed is not None else None
         if record is not None:
             self._own_type(vid, record.vehicle_type)
@@ -688,13 +657,25 @@ class SumoTraffic(LiveSumo):
             return
         if self._draws is None:
             return
-        heading = np.radians(row[2])
-        along = self._unit[0]
-        direction = 1 if math.sin(heading) * along[0] + math.cos(heading) * along[1] >= 0.0 else 2
+        direction = self._crossing_direction(vid)
+        if direction is None:  # no deck edge ahead on its route: the way it heads
+            heading = np.radians(row[2])
+            along = self._unit[0]
+            direction = 1 if math.sin(heading) * along[0] + math.cos(heading) * along[1] >= 0.0 else 2
         draw = self._draws.draw(vid, self.types[vtype], direction)
         if draw.vehicle_type is not None:
             self._own_type(vid, draw.vehicle_type)
         self._label[vid] = (draw.vehicle_class, draw.wander, draw.source)
+
+    def _crossing_direction(self, vid: str) -> int | None:
+        """Grave's direction of the deck edge next on the vehicle's route from where it is (:attr:`deck_directions`),
+        or None if it crosses none from there. Not its heading: first seen on a side road or in a junction, a
+        vehicle heads across the axis, or away from the way it will cross."""
+        try:
+            route, index = self.libsumo.vehicle.getRoute(vid), self.libsumo.vehicle.getRouteIndex(vid)
+        except Exception:  # noqa: BLE001 - no route to be had (SUMO's exception types vary): its heading decides
+            return None
+        return next((self.deck_directions[e] for e in route[max(index, 0):] if e in self.deck_directions), None)
 
     def _own_type(self, vid: str, own: VehicleType) -> None:
         """A vehicle with a vehicle type of its own (its own axles and loads).

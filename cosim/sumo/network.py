@@ -438,6 +438,19 @@ def watched_lanes(net_file: str | Path, deck_lanes: Iterable[str], reach: float,
     return tuple(found)
 
 
+def deck_directions(net_file: str | Path, deck_lanes: Iterable[str], axis: BridgeAxis) -> dict[str, int]:
+    """Each deck lane's edge -> the way it drives, as Grave's direction (:mod:`cosim.core.loads`): 1 along the
+    bridge axis (from its lane's start to its end), 2 against it."""
+    net = read_network(net_file)
+    along = axis.unit()[0]
+    out: dict[str, int] = {}
+    for lane_id in deck_lanes:
+        lane = net.getLane(lane_id)
+        (x0, y0), (x1, y1) = lane.getShape()[0][:2], lane.getShape()[-1][:2]
+        out.setdefault(lane.getEdge().getID(), 1 if (x1 - x0) * along[0] + (y1 - y0) * along[1] >= 0.0 else 2)
+    return out
+
+
 def wheel_paths_beyond(location: BridgeLocation, deck_y: tuple[float, float], what: str = "the deck") -> str:
     """A line saying where the lanes' centre lines (the wheel paths) leave ``what`` (its lateral extent
     ``deck_y``, m) over the deck's length, or "" if they do not: an edge that curves against the straight axis."""
