@@ -158,7 +158,6 @@ class LiveSumo(FramedSource):
         self.edges: tuple[str, ...] = ()
         self.lanes: tuple[str, ...] = ()
         self.deck_lanes: tuple[str, ...] = ()
-        self.deck_directions: dict[str, int] = {}  # deck edge -> Grave's direction: 1 along the axis, 2 against
         self.reach = WATCH_MARGIN
         self._models: dict[str, VehicleModel] = {}  # every type known so far (this source's own table)
         self._fresh: dict[str, VehicleModel] = {}  # known since the last frame was handed on
@@ -334,6 +333,7 @@ class SumoTraffic(LiveSumo):
         self._recorded: set[str] = set()  # vehicles whose load record went out (at their entry onto the deck)
         self._trails: AxleTrails | None = None  # each followed vehicle's bumper path (its axles stand on it)
         self._lane_geometry: dict[str, LaneLine | None] = {}  # None: a line of fewer than two points
+        self.deck_directions: dict[str, int] = {}  # deck edge -> Grave's direction: 1 along the axis, 2 against
         self.libsumo: Any = None  # the libsumo module once started (imported there, not here)
         self._scratch: Path | None = None
         self._watched: set[str] = set()

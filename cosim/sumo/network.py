@@ -323,9 +323,7 @@ def locate_bridge(net_file: str | Path, edges: Sequence[str], length: float | No
         pts = polyline_samples(lane.getShape()) - origin
         along, across = pts @ e_dir, pts @ n_dir
         centre_lines[lane.getID()] = (along, across)
-        lane_chord = np.subtract(lane.getShape()[-1][:2], lane.getShape()[0][:2])
-        direction = 1 if float(np.dot(lane_chord, e_dir)) >= 0 else -1
-        return (lane, edge, float(np.median(across)), float(lane.getWidth()), direction,
+        return (lane, edge, float(np.median(across)), float(lane.getWidth()), lane_sense(lane, e_dir),
                 float(along.min()), float(along.max()))
 
     rows = [row(edge, lane) for edge, lane in lanes]
@@ -438,16 +436,20 @@ def watched_lanes(net_file: str | Path, deck_lanes: Iterable[str], reach: float,
     return tuple(found)
 
 
+def lane_sense(lane: Any, along: Any) -> int:
+    """+1 if a sumolib lane drives along the unit vector ``along`` (its chord, first point to last), else -1."""
+    return 1 if float(np.dot(np.subtract(lane.getShape()[-1][:2], lane.getShape()[0][:2]), along)) >= 0.0 else -1
+
+
 def deck_directions(net_file: str | Path, deck_lanes: Iterable[str], axis: BridgeAxis) -> dict[str, int]:
     """Each deck lane's edge -> the way it drives, as Grave's direction (:mod:`cosim.core.loads`): 1 along the
-    bridge axis (from its lane's start to its end), 2 against it."""
+    bridge axis, 2 against it (:func:`lane_sense`)."""
     net = read_network(net_file)
     along = axis.unit()[0]
     out: dict[str, int] = {}
     for lane_id in deck_lanes:
         lane = net.getLane(lane_id)
-        (x0, y0), (x1, y1) = lane.getShape()[0][:2], lane.getShape()[-1][:2]
-        out.setdefault(lane.getEdge().getID(), 1 if (x1 - x0) * along[0] + (y1 - y0) * along[1] >= 0.0 else 2)
+        out.setdefault(lane.getEdge().getID(), 1 if lane_sense(lane, along) > 0 else 2)
     return out
 
 

@@ -49,7 +49,7 @@ from cosim.core.traffic import LoadRecord
 from cosim.errors import ConfigError, SumoError, first_line
 
 from .loads import FRONT_OVERHANG, REAR_OVERHANG
-from .network import BridgeAxis, is_vehicle_lane, lane_graph, polyline_samples, read_network
+from .network import BridgeAxis, is_vehicle_lane, lane_graph, lane_sense, polyline_samples, read_network
 from .vtypes import VehicleType, loaded_vehicle_type
 
 __all__ = ["APPROACH", "EXIT", "LOOKAHEAD", "MAX_SPEED", "RECORD_VTYPES", "RecordFeed", "RecordRoute",
@@ -196,9 +196,8 @@ def deck_lanes(net_file: str | Path, axis: BridgeAxis, y_range: tuple[float, flo
             over = (x > 0.0) & (x < axis.length) & (y >= lo) & (y <= hi)
             if not over.any():
                 continue
-            chord = np.subtract(lane.getShape()[-1][:2], lane.getShape()[0][:2])
             found.append(DeckLaneLine(lane.getID(), float(np.median(y[over])), float(lane.getWidth()),
-                                      1 if float(np.dot(chord, e)) >= 0.0 else -1))
+                                      lane_sense(lane, e)))
     return tuple(found)
 
 
