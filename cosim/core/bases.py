@@ -92,7 +92,10 @@ class DirectBasis(_Counts):
         self.cholesky_rows = np.zeros((self.n, bw + 1))
         for k in range(bw + 1):
             self.cholesky_rows[: self.n - k, k] = self.cholesky_band[bw - k, k:]
-        self.inverse = scipy.linalg.cho_solve_banded((self.cholesky_band, False), np.eye(self.n), check_finite=False)
+        # C order and int64 CSR indices (kernel_arrays) for every engine and basis of a beam deck: numba compiles
+        # the block loop once per argument layout (about a minute each on a first run), and LAPACK's answer is F.
+        self.inverse = np.ascontiguousarray(
+            scipy.linalg.cho_solve_banded((self.cholesky_band, False), np.eye(self.n), check_finite=False))
         # Full DOF -> reduced index, -1 for restrained DOFs.
         self.reduced_map = np.full(bridge.ndof, -1, dtype=np.int64)
         self.reduced_map[bridge.free] = np.arange(self.n)
@@ -109,9 +112,10 @@ class DirectBasis(_Counts):
 
     def kernel_arrays(self) -> BasisArrays:
         """What the compiled block loop needs of this basis."""
+        index = [np.asarray(a, dtype=np.int64) for a in (self.K.indptr, self.K.indices, self.M.indptr, self.M.indices)]
         return BasisArrays(
-            DIRECT, self.n, self.cholesky_rows, self.K.indptr, self.K.indices, self.K.data,
-            self.M.indptr, self.M.indices, self.M.data, self.ray_alpha, self.ray_beta, self.inverse,
+            DIRECT, self.n, self.cholesky_rows, index[0], index[1], self.K.data,
+            index[2], index[3], self.M.data, self.ray_alpha, self.ray_beta, self.inverse,
             self.reduced_map, _EMPTY_2, _EMPTY_1, _EMPTY_1, _EMPTY_1,
         )
 
