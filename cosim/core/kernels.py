@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from .jit import compiled
+from .small_solve import solve_small
 from .surface_contact import NO_SURFACE, SURFACE_DECK, surface_rows
 from .traffic import on_deck
 from .vehicles import linear, quarter_car, tyre_quarter_car
@@ -357,35 +358,6 @@ def _capacitance(ainv, idx, rv, p, groups, S):  # noqa: ANN001, ANN201
                         acc_ += ainv[r_, c_] * rv[jv, 0, ll]
                 s += p[i, kk] * acc_
             S[i, jv] = s
-
-
-@compiled(inline=True)
-def solve_small(S, b):  # noqa: ANN001, ANN201
-    """b <- S^{-1} b for the small capacitance matrix (q x q), by Gaussian elimination with partial pivoting in
-    place (S is overwritten). LAPACK's solve allocated and cost more than the elimination for the few
-    vehicles on a deck (about 2 us a step; benchmarks/bench_step.py)."""
-    q = b.shape[0]
-    for c in range(q):
-        pivot = c
-        for r in range(c + 1, q):
-            if abs(S[r, c]) > abs(S[pivot, c]):
-                pivot = r
-        if pivot != c:
-            for k in range(c, q):
-                S[c, k], S[pivot, k] = S[pivot, k], S[c, k]
-            b[c], b[pivot] = b[pivot], b[c]
-        inv = 1.0 / S[c, c]
-        for r in range(c + 1, q):
-            f = S[r, c] * inv
-            if f != 0.0:
-                for k in range(c + 1, q):
-                    S[r, k] -= f * S[c, k]
-                b[r] -= f * b[c]
-    for r in range(q - 1, -1, -1):
-        acc = b[r]
-        for k in range(r + 1, q):
-            acc -= S[r, k] * b[k]
-        b[r] = acc / S[r, r]
 
 
 @compiled

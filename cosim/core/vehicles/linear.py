@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import compiled
+from ..small_solve import solve_small
 
 
 @compiled
@@ -58,6 +59,15 @@ def _predictors(z, zd, zdd, dt, beta, gamma):  # noqa: ANN001, ANN201
     return z_star, zd_star
 
 
+@compiled(inline=True)
+def _solve_into(a_mat, b, out):  # noqa: ANN001, ANN201
+    """out <- a_mat^{-1} b (a_mat kept: its copy is eliminated; ``out`` may be ``b``)."""
+    work = a_mat.copy()
+    for r in range(len(b)):
+        out[r] = b[r]
+    solve_small(work, out)
+
+
 @compiled
 def group_coefficients(g, groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2):  # noqa: ANN001, ANN201
     """Deck-force coefficients of every contact of vehicle ``g`` and its coupling matrix H (docs/theory.md §11.2)."""
@@ -85,18 +95,24 @@ def group_coefficients(g, groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2
         t0[k] = k_t * (bc[k] @ z_star - dots[0, j] - kin.r[step, j]) + \
             c_t * (bc[k] @ zd_star - dots[2, j] - v * dots[1, j] - v * kin.r_x[step, j])
         mt[k] = k_t * b2 + c_t * g1
-        a_mat += ca * mt[k] * np.outer(bc[k], bc[k])
+        for r in range(nz):  # loops, not np.outer and slice assignments: their compiled forms cost seconds to build
+            for c in range(nz):
+                a_mat[r, c] += ca * mt[k] * (bc[k, r] * bc[k, c])
         r_vec -= ca * t0[k] * bc[k]
         c0[j] = mt[k]
         c1[j] = c_t * v * b2
-    rhs = np.zeros((nz, nc + 1))
-    rhs[:, 0] = r_vec
+    _solve_into(a_mat, r_vec, z0dd)
+    column = np.zeros(nz)
     for k in range(nc):
-        if not groups.flying[first + k]:
-            rhs[:, k + 1] = bc[k]
-    sol = np.linalg.solve(a_mat, rhs)
-    z0dd[:] = sol[:, 0]
-    gm[:, :] = sol[:, 1:]
+        if groups.flying[first + k]:  # a flying tyre couples nothing
+            for r in range(nz):
+                gm[r, k] = 0.0
+            continue
+        for r in range(nz):
+            column[r] = bc[k, r]
+        _solve_into(a_mat, column, column)
+        for r in range(nz):
+            gm[r, k] = column[r]
     for k in range(nc):
         j = first + k
         for m in range(nc):
@@ -183,9 +199,10 @@ def group_update(g, groups, fleet, kin, step, dots, scheme, vstate, contact, wei
     z_star, zd_star = _predictors(z, zd, zdd, dt, beta, gamma)
     z_new = z_star + b2 * zdd_new
     zd_new = zd_star + g1 * zdd_new
-    z[:] = z_new
-    zd[:] = zd_new
-    zdd[:] = zdd_new
+    for i in range(len(z)):
+        z[i] = z_new[i]
+        zd[i] = zd_new[i]
+        zdd[i] = zdd_new[i]
     f = cv @ zd_new + kv @ z_new
     for k in range(nc):
         j = first + k
@@ -200,4 +217,5 @@ def group_update(g, groups, fleet, kin, step, dots, scheme, vstate, contact, wei
         vstate[5, j] = bc[k] @ zdd_new
         vstate[6, j] = 0.0
         vstate[7, j] = tyre[k]
-    fel[:] = f
+    for i in range(len(f)):
+        fel[i] = f[i]
