@@ -364,6 +364,34 @@ def header_lines(start: RunStart) -> list[str]:
     ]
 
 
+class CompileNotice:
+    """One line on stderr when the solver's kernels are being compiled, not loaded from numba's cache: the first
+    run after installing or upgrading cosim waits about a minute for it before its first time step."""
+
+    LINE = ("Compiling cosim's solver for this computer: once after installing or upgrading cosim, "
+            "about a minute before the first time step ...")
+
+    def __init__(self) -> None:
+        self.shown = False
+        self._stop: Any = None
+
+    def start(self) -> None:
+        from cosim.core.jit import on_compile
+
+        if self._stop is None:
+            self._stop = on_compile(self._compiling)
+
+    def _compiling(self, name: str) -> None:
+        if not self.shown:
+            self.shown = True
+            print(self.LINE, file=sys.stderr, flush=True)
+
+    def stop(self) -> None:
+        if self._stop is not None:
+            self._stop()
+            self._stop = None
+
+
 class RunDisplay:
     """What ``cosim run`` and ``cosim replay`` show while a logged run goes: its header on stdout once the
     bridge is built (:meth:`ready`), then its progress on stderr (a progress callback); and the one line
@@ -373,18 +401,22 @@ class RunDisplay:
         self.quiet = quiet
         self.duration = 0.0
         self.progress: Progress | None = None
+        self.notice = CompileNotice()
 
     def ready(self, start: RunStart) -> None:
         print_lines(header_lines(start))
         sys.stdout.flush()
         self.duration = start.duration
         self.progress = Progress(start.duration, show=not self.quiet)
+        if not self.quiet:
+            self.notice.start()
 
     def __call__(self, fraction: float) -> None:
         if self.progress is not None:
             self.progress(fraction)
 
     def close(self) -> None:
+        self.notice.stop()
         if self.progress is not None:
             self.progress.close()
 

@@ -66,3 +66,25 @@ def compiled(func: Callable[..., Any] | None = None, *, nogil: bool = False, inl
     """
     decorate = njit(cache=True, nogil=nogil, inline="always" if inline else "never")
     return decorate(func) if func is not None else decorate
+
+
+def on_compile(callback: Callable[[str], None]) -> Callable[[], None]:
+    """Call ``callback(name)`` each time numba starts compiling a function in this process (a compiled function
+    loaded from its cache is not compiled: no call). Returns the function that stops it.
+
+    For a notice while a first run after installing cosim compiles its kernels (about a minute, silent otherwise).
+    Uses numba's event API (``numba:compile``).
+    """
+    from numba.core import event
+
+    class _CompileListener(event.Listener):
+        def on_start(self, ev: Any) -> None:
+            dispatcher = ev.data.get("dispatcher")
+            callback(getattr(getattr(dispatcher, "py_func", None), "__qualname__", "?"))
+
+        def on_end(self, ev: Any) -> None:
+            pass
+
+    listener = _CompileListener()
+    event.register("numba:compile", listener)
+    return lambda: event.unregister("numba:compile", listener)

@@ -220,3 +220,23 @@ def test_progress_bar_on_a_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
     progress(1.0)
     progress.close()
     assert quiet.getvalue() == ""
+
+
+def test_a_compilation_before_the_first_step_is_announced_once(capsys: pytest.CaptureFixture[str]) -> None:
+    # A first run after installing compiles the solver for about a minute with nothing else on the screen: the
+    # display says so, once, when numba really compiles (a real compilation of a new function here).
+    import numba
+
+    def fresh(k: int):  # noqa: ANN202
+        return numba.njit(cache=False)(lambda x: x + k)
+
+    notice = cli_summary.CompileNotice()
+    notice.start()
+    try:
+        fresh(1)(1.0)
+        fresh(2)(1.0)  # a second compilation: no second line
+    finally:
+        notice.stop()
+    fresh(3)(1.0)  # stopped: nothing
+    err = capsys.readouterr().err
+    assert err.count("Compiling cosim's solver") == 1 and err.endswith("before the first time step ...\n")
