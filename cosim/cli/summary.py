@@ -6,6 +6,7 @@ Imported by those commands when they run (it loads the numerical core), never to
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -373,7 +374,7 @@ class CompileNotice:
 
     def __init__(self) -> None:
         self.shown = False
-        self._stop: Any = None
+        self._stop: Callable[[], None] | None = None
 
     def start(self) -> None:
         from cosim.core.jit import on_compile
