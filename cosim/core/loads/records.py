@@ -292,12 +292,15 @@ def _ticks(line: _Line, raw: dict[str, int], fmt: Format) -> int:
         raise line.fail(f"the time {raw['hour']}:{raw['minute']:02d} is not a time of day; expected hours 0-23 "
                         "and minutes 0-59")
     minute = (raw["hour"] * 60 + raw["minute"]) * 60
+    # BTLS rounds a time in the minute's last half-unit up without carrying (Vehicle::writeMONData and
+    # writeCASTORData write 60000 ms, or 60 s and 0 hundredths) and reads it as the next minute's start
     if fmt.time_unit == 0.001:
-        if raw["millis"] > 59999:
-            raise line.fail(f"the milliseconds of the minute are {raw['millis']}; expected 0-59999")
+        if raw["millis"] > 60000:
+            raise line.fail(f"the milliseconds of the minute are {raw['millis']}; expected 0-60000")
         return minute * 1000 + raw["millis"]
-    if raw["second"] > 59:
-        raise line.fail(f"the seconds are {raw['second']}; expected 0-59")
+    if raw["second"] * 100 + raw["hundredths"] > 6000:
+        raise line.fail(f"the time within the minute is {raw['second']} s and {raw['hundredths']} hundredths; "
+                        "expected 0-59 s and 0-99 hundredths (or 60 s and 0, the next minute's start)")
     return (minute + raw["second"]) * 100 + raw["hundredths"]
 
 
