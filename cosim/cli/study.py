@@ -61,6 +61,8 @@ def add_parser(commands: Subcommands) -> None:
 def cmd_study(args: argparse.Namespace) -> int:
     from cosim.study import load_study, run_study, summary_text
 
+    from .summary import CompileNotice
+
     study = load_study(args.study, output=args.out)
     bar: Any = None
     failures: list[str] = []
@@ -88,9 +90,16 @@ def cmd_study(args: argparse.Namespace) -> int:
             bar.set_postfix_str(f"{len(failures)} failed", refresh=False)
         bar.update(done - bar.n)
 
+    def compiling() -> None:  # from the Dask client's thread: tqdm.write keeps the bar whole
+        if bar is not None:
+            bar.write(CompileNotice.STUDY_LINE, file=sys.stderr)
+        else:
+            print(CompileNotice.STUDY_LINE, file=sys.stderr, flush=True)
+
     try:
         outcome = run_study(study, workers=args.workers, scheduler=args.scheduler, progress=progress,
-                            redo=args.redo, plots=False if args.no_plots else None)
+                            redo=args.redo, plots=False if args.no_plots else None,
+                            compiling=None if args.quiet else compiling)
     except KeyboardInterrupt as exc:
         if bar is not None:
             bar.close()

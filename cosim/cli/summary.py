@@ -371,6 +371,9 @@ class CompileNotice:
 
     LINE = ("Compiling cosim's solver for this computer: once after installing or upgrading cosim, "
             "about a minute before the first time step ...")
+    #: What ``cosim study`` says (its runs compile on the workers, each before its first run ends).
+    STUDY_LINE = ("Compiling cosim's solver for this computer: once after installing or upgrading cosim, "
+                  "about a minute before the first runs finish ...")
 
     def __init__(self) -> None:
         self.shown = False

@@ -63,6 +63,8 @@ STOP_CHECK_EVERY = 0.5
 STOP_WAIT = 30.0
 #: How often the study's main thread looks for finished runs and held signals while runs are on Dask, s.
 POLL = 0.05
+#: The Dask event topic a worker tells the study's client on when it starts compiling the solver.
+COMPILE_TOPIC = "cosim-compiling"
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -73,6 +75,39 @@ log = logging.getLogger(__name__)
 
 
 # --------------------------------------------------------------------------- one run (on a worker)
+
+
+_relaying = False
+
+
+def relay_compilation() -> None:
+    """On a Dask worker: the first time numba compiles in this process, tell the study's client (Dask event
+    :data:`COMPILE_TOPIC`). After installing cosim each worker compiles the solver before its first run ends,
+    about a minute in which the study's bar shows no run done; later runs load it from numba's cache."""
+    global _relaying
+    if _relaying:
+        return
+    from distributed import get_worker
+
+    from cosim.core.jit import on_compile
+
+    worker = get_worker()
+    told = False
+
+    def tell(name: str) -> None:
+        nonlocal told
+        if not told:
+            told = True
+            worker.log_event(COMPILE_TOPIC, {"function": name})
+
+    on_compile(tell)  # for the worker process's life: one event at most
+    _relaying = True
+
+
+def execute_run_on_worker(task: RunTask) -> dict[str, Any]:
+    """:func:`execute_run` on a Dask worker, its compilation of the solver told to the study's client."""
+    relay_compilation()
+    return execute_run(task)
 
 
 def execute_run(task: RunTask) -> dict[str, Any]:
@@ -260,6 +295,7 @@ def run_study(
     progress: Progress | None = None,
     redo: bool = False,
     plots: bool | None = None,
+    compiling: Callable[[], None] | None = None,
 ) -> StudyOutcome:
     """Run every run of ``study`` that has no up-to-date result, then write the table and plots.
 
@@ -274,6 +310,8 @@ def run_study(
             at the start and after every run.
         redo: run every run again, even those with up-to-date results.
         plots: write the plots (default: ``study.plots``).
+        compiling: called once, from any thread, when a run starts compiling the solver rather than loading it
+            from numba's cache (after installing or upgrading cosim: about a minute before the first runs end).
 
     Returns:
         The rows, what ran and what was reused, and the files written.
@@ -316,10 +354,14 @@ def run_study(
     try:
         if todo:
             if workers == 0 and scheduler is None:
-                for task in todo:
-                    finished(execute_run(task))
+                stop = _told_once(compiling)
+                try:
+                    for task in todo:
+                        finished(execute_run(task))
+                finally:
+                    stop()
             else:
-                used = _run_on_dask(study, todo, workers, scheduler, finished)
+                used = _run_on_dask(study, todo, workers, scheduler, finished, compiling)
     except KeyboardInterrupt:
         # The table of the runs completed so far (ok or failed); runs that finished on a worker but
         # whose result had not come back yet count too; runs stopped half-way do not.
@@ -344,8 +386,39 @@ def run_study(
     )
 
 
+def _told_once(compiling: Callable[[], None] | None) -> Callable[[], None]:
+    """``compiling`` called at the first compilation in this process; returns the function that stops it."""
+    if compiling is None:
+        return lambda: None
+    from cosim.core.jit import on_compile
+
+    told = threading.Event()
+
+    def tell(name: str) -> None:
+        if not told.is_set():
+            told.set()
+            compiling()
+
+    return on_compile(tell)
+
+
+def listen_for_compilation(client: Any, compiling: Callable[[], None] | None) -> None:
+    """``compiling`` called (in the client's event thread) at the first :data:`COMPILE_TOPIC` event from the
+    workers (:func:`relay_compilation`), once however many workers compile."""
+    if compiling is None:
+        return
+    told = threading.Event()
+
+    def heard(event: Any) -> None:
+        if not told.is_set():
+            told.set()
+            compiling()
+
+    client.subscribe_topic(COMPILE_TOPIC, heard)
+
+
 def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, scheduler: str | None,
-                 finished: Callable[[dict[str, Any]], None]) -> int:
+                 finished: Callable[[dict[str, Any]], None], compiling: Callable[[], None] | None = None) -> int:
     """Submit the runs to a Dask cluster and hand every row to ``finished`` as it arrives; returns the workers."""
     from dask.distributed import Client, LocalCluster, as_completed
 
@@ -386,10 +459,11 @@ def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, schedul
                 raise guard.held
             n_workers = len(client.scheduler_info(n_workers=-1).get("workers", {})) if scheduler else \
                 len(cluster.workers)  # type: ignore[union-attr]
+            listen_for_compilation(client, compiling)
             by_key: dict[str, RunTask] = {}
             for task in todo:
                 key = f"cosim-run-{study.name}-{task.run_id}-{task.fingerprint[:12]}"
-                future = client.submit(execute_run, task, key=key, pure=False, retries=0)
+                future = client.submit(execute_run_on_worker, task, key=key, pure=False, retries=0)
                 by_key[str(future.key)] = task
                 futures.append(future)
             pending = as_completed(futures)
