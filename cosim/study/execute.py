@@ -80,6 +80,22 @@ log = logging.getLogger(__name__)
 _relaying = False
 
 
+def _once(callback: Callable[[Any], None]) -> Callable[[Any], None]:
+    """``callback`` for the first call only (from any thread): a compilation is said once, not per function."""
+    lock = threading.Lock()
+    done = False
+
+    def first(value: Any) -> None:
+        nonlocal done
+        with lock:
+            if done:
+                return
+            done = True
+        callback(value)
+
+    return first
+
+
 def relay_compilation() -> None:
     """On a Dask worker: the first time numba compiles in this process, tell the study's client (Dask event
     :data:`COMPILE_TOPIC`). After installing cosim each worker compiles the solver before its first run ends,
@@ -92,15 +108,8 @@ def relay_compilation() -> None:
     from cosim.core.jit import on_compile
 
     worker = get_worker()
-    told = False
-
-    def tell(name: str) -> None:
-        nonlocal told
-        if not told:
-            told = True
-            worker.log_event(COMPILE_TOPIC, {"function": name})
-
-    on_compile(tell)  # for the worker process's life: one event at most
+    # for the worker process's life: one event at most
+    on_compile(_once(lambda name: worker.log_event(COMPILE_TOPIC, {"function": name})))
     _relaying = True
 
 
@@ -392,14 +401,7 @@ def _told_once(compiling: Callable[[], None] | None) -> Callable[[], None]:
         return lambda: None
     from cosim.core.jit import on_compile
 
-    told = threading.Event()
-
-    def tell(name: str) -> None:
-        if not told.is_set():
-            told.set()
-            compiling()
-
-    return on_compile(tell)
+    return on_compile(_once(lambda name: compiling()))
 
 
 def listen_for_compilation(client: Any, compiling: Callable[[], None] | None) -> None:
@@ -407,14 +409,7 @@ def listen_for_compilation(client: Any, compiling: Callable[[], None] | None) ->
     workers (:func:`relay_compilation`), once however many workers compile."""
     if compiling is None:
         return
-    told = threading.Event()
-
-    def heard(event: Any) -> None:
-        if not told.is_set():
-            told.set()
-            compiling()
-
-    client.subscribe_topic(COMPILE_TOPIC, heard)
+    client.subscribe_topic(COMPILE_TOPIC, _once(lambda event: compiling()))
 
 
 def _run_on_dask(study: Study, todo: list[RunTask], workers: int | None, scheduler: str | None,
