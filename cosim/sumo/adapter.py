@@ -548,31 +548,40 @@ class SumoTraffic(LiveSumo):
             raise SumoError(f"SUMO failed at t = {ls.simulation.getTime() if ls else '?'} s: {first_line(exc)}") \
                 from None
         self.sumo_steps += 1
-        t = self.sumo_steps * self.step
+        t = self.sumo_steps * self.settings.step
         read = self._read
         assert read is not None
         present = set(itertools.chain.from_iterable(map(read.lane_vehicles, self.lanes)))
-        self._done &= present  # a vehicle that left the watched lanes is forgotten
-        present -= self._done
-        veh = ls.vehicle
-        fixed = self._fixed
-        for vid in present - self._watched:  # what does not change while it drives: read once
-            fixed[vid] = (veh.getTypeID(vid), veh.getLength(vid))
+        done = self._done
+        if done:
+            done &= present  # a vehicle that left the watched lanes is forgotten
+            present -= done
+        layout = self._layout
+        if present != self._watched:  # a vehicle came or went (most steps: the same vehicles as the step before)
+            fixed = self._fixed
+            veh = ls.vehicle
+            for vid in present - self._watched:  # what does not change while it drives: read once
+                fixed[vid] = (veh.getTypeID(vid), veh.getLength(vid))
+            for vid in self._watched - present:
+                self._forget(vid)
+            self._watched = present
+            if not present:
+                return Frame(t, (), _EMPTY, _EMPTY, _EMPTY, _EMPTY, ())
+            layout = self._layout
+            ids = tuple(sorted(present))
+        elif not present:
+            return Frame(t, (), _EMPTY, _EMPTY, _EMPTY, _EMPTY, ())
+        else:  # the same vehicles: the layout of the step before is theirs (any vehicle gone drops it)
+            ids = layout.vehicles if layout is not None else tuple(sorted(present))
         trails = self._trails
         assert trails is not None
-        for vid in self._watched - present:
-            self._forget(vid)
-        self._watched = present
-        if not present:
-            return Frame(t=t, ids=(), x=_EMPTY, y=_EMPTY, v=_EMPTY, a=_EMPTY, types=())
-        ids = tuple(sorted(present))
         position, angle, speed, acceleration = read.position, read.angle, read.speed, read.acceleration
+        fixed = self._fixed
         flat: list[float] = []  # one flat list, reshaped: a third cheaper than numpy's reading a list of tuples
         for vid in ids:
             flat += position(vid)
             flat += (angle(vid), speed(vid), acceleration(vid), fixed[vid][1])
         num = np.array(flat, dtype=float).reshape(-1, 6)
-        layout = self._layout
         if layout is None or layout.vehicles != ids:
             layout = self._layout = self._new_layout(ids, num)
         # One contact point per axle (a vType without axles: one at mid-length), behind the bumper on the path
@@ -581,23 +590,25 @@ class SumoTraffic(LiveSumo):
         owner = layout.owner
         xyva, marks, kept, on_deck = contact_step(num, layout.slots, trails.arrays, layout.back, owner, layout.left,
                                                   layout.wander, self._axis_frame, self._contact_settings)
-        x, y, v, a = xyva
         loads: tuple[LoadRecord, ...] = ()
         if layout.unrecorded and on_deck:  # a vehicle whose load record has not gone out yet
-            loads = self._entering(ids, layout.vehicle_types, num, owner, x, y)
+            loads = self._entering(ids, layout.vehicle_types, num, owner, xyva[0], xyva[1])
             if loads:
                 layout.unrecorded = any(vid not in self._recorded for vid in ids)
         # Vehicles gone for good are dropped every few steps, at the steps they were before contact_step found them
         # at every one (the same layouts and slots as then); a late drop only reads a far vehicle a while longer.
         axle_ids, axle_types = layout.ids, layout.types
-        if self.sumo_steps % DROP_DEPARTED_EVERY == 0 and marks[len(axle_ids):].any():
-            self._drop_departed(ids, marks[len(axle_ids):])
-        if kept < len(axle_ids):
-            keep = marks[:len(axle_ids)]
-            axle_ids = tuple(i for i, k in zip(axle_ids, keep) if k)
-            axle_types = tuple(ty for ty, k in zip(axle_types, keep) if k)
-            x, y, v, a = x[keep], y[keep], v[keep], a[keep]
-        return Frame(t=t, ids=axle_ids, x=x, y=y, v=v, a=a, types=axle_types, loads=loads)
+        contacts = len(axle_ids)
+        if self.sumo_steps % DROP_DEPARTED_EVERY == 0 and marks[contacts:].any():
+            self._drop_departed(ids, marks[contacts:])
+        if kept < contacts:  # one selection of the four rows, the names by a list of flags (not numpy's bools)
+            keep = marks[:contacts]
+            flags = keep.tolist()
+            axle_ids, axle_types = tuple(itertools.compress(axle_ids, flags)), tuple(itertools.compress(axle_types,
+                                                                                                       flags))
+            xyva = xyva[:, keep]
+        x, y, v, a = xyva
+        return Frame(t, axle_ids, x, y, v, a, axle_types, loads)  # by position: a third cheaper than by keywords
 
     def _new_layout(self, ids: tuple[str, ...], num: np.ndarray) -> _AxleLayout:
         """The contact points of a set of followed vehicles (sorted ids), which stay the same from step to step
