@@ -8,7 +8,7 @@ against ~20 us for the paper bridge with one vehicle; benchmarks/bench_step.py).
 The mathematics is docs/theory.md §6; this module is its only implementation.
 
 One loop, :func:`advance_block`, serves both bases and both kinds of deck. The
-deck is the seam between the vehicles and the structure (:func:`deck_rows`): a
+deck is the seam between the vehicles and the structure (in :func:`advance_block`): a
 beam line (its elements' cubics, then projected on the basis) or a surface given
 by its modes (each mode's bicubic Hermite patch, docs/theory.md §13: the rows come
 out in modal coordinates directly). A contact row is stored
@@ -177,13 +177,20 @@ def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
     point exactly on a node takes the element ahead of it in its direction of
     travel (speed ``v``), so that mirrored crossings see mirrored rows.
     """
+    _element_rows(x, y, v, deck.nodes_x, deck.cw, deck.ct, deck.y_s, deck.length, deck.y_lo, deck.y_hi, elems, vals,
+                  geo)
+
+
+@compiled(inline=True)
+def _element_rows(x, y, v, nodes_x, cw, ct, y_s, length, y_lo, y_hi, elems, vals, geo):  # noqa: ANN001, ANN201
+    """:func:`contact_rows` on the deck's arrays themselves: the block loop calls it at every step, and each named
+    tuple an inlined function takes costs a reference count on every array in it (tens at every step)."""
     q = x.shape[0]
-    nodes_x, cw, ct = deck.nodes_x, deck.cw, deck.ct
     n_el = nodes_x.shape[0] - 1
     for i in range(q):
         elems[i] = -1
         xi_abs = x[i]
-        if not _on_deck(xi_abs, deck.length) or not deck.y_lo <= y[i] <= deck.y_hi:
+        if not _on_deck(xi_abs, length) or not y_lo <= y[i] <= y_hi:
             for k in range(cw.shape[1]):
                 vals[i, 0, k] = 0.0
                 vals[i, 1, k] = 0.0
@@ -191,14 +198,14 @@ def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
             continue
         e = np.searchsorted(nodes_x, xi_abs, side="right") - 1
         e = min(max(e, 0), n_el - 1)
-        snap = NODE_SNAP * deck.length
+        snap = NODE_SNAP * length
         if v[i] < 0.0 and e > 0 and xi_abs - nodes_x[e] <= snap:
             e -= 1  # at the node starting element e: the element ahead is e - 1
         elif v[i] >= 0.0 and e < n_el - 1 and nodes_x[e + 1] - xi_abs <= snap:
             e += 1  # at the node ending element e: the element ahead is e + 1
         L = nodes_x[e + 1] - nodes_x[e]
         xi = min(max((xi_abs - nodes_x[e]) / L, 0.0), 1.0)
-        lever = y[i] - deck.y_s
+        lever = y[i] - y_s
         p0 = (1.0, xi, xi * xi, xi * xi * xi)
         p1 = (0.0, 1.0 / L, 2.0 * xi / L, 3.0 * xi * xi / L)
         p2 = (0.0, 0.0, 2.0 / (L * L), 6.0 * xi / (L * L))
@@ -216,52 +223,40 @@ def contact_rows(x, y, v, deck, elems, vals, geo):  # noqa: ANN001, ANN201
         geo[i, 0], geo[i, 1], geo[i, 2] = xi, lever, L
 
 
-@compiled(inline=True)
-def deck_rows(basis, deck, kin, step, elems, vals, geo, idx, rv, pidx, prv, bs, br, coef):  # noqa: ANN001, ANN201
-    """The deck seam: every contact point's rows in the basis' coordinates (``idx``, ``rv``) and where it is
-    (``elems[i]`` < 0: off the deck). A beam deck evaluates its elements' cubics at the points and projects
-    them on the basis (:func:`contact_rows`, :func:`project_contacts`); a deck given by its modes gives the
-    rows in its modal coordinates directly (:func:`surface_rows`)."""
-    if deck.kind == SURFACE_DECK:
-        surface_rows(kin, step, deck, elems, rv, bs, br, coef)
-    else:
-        contact_rows(kin.x[step], kin.y, kin.v[step], deck, elems, vals, geo)
-        project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv)
-
-
 # ----------------------------------------------- basis-specific operations
 @compiled(inline=True)
-def internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha):  # noqa: ANN001, ANN201
-    """rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n  (docs/theory.md (6.2)-(6.4))."""
-    n = basis.n
-    if basis.kind == DIRECT:  # C = ray_a M + ray_b K: two CSR products instead of three
+def internal_rhs(kind, k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat, ray_a, ray_b, c_diag, k_diag, d, v, force,  # noqa: ANN001, ANN201, E501
+                 d_star, v_star, tmp, rhs, ca, alpha):
+    """rhs = -(1+alpha)(C v* + K d*) + alpha (C v + K d) - alpha F_n  (docs/theory.md (6.2)-(6.4)); the basis'
+    arrays (:data:`BasisArrays`) and the state's (``d``, ``v``, ``force``) one by one (see :func:`advance_block`)."""
+    n = rhs.shape[0]
+    if kind == DIRECT:  # C = ray_a M + ray_b K: two CSR products instead of three
         for j in range(n):
-            tmp[j] = d_star[j] + basis.ray_b * v_star[j]
+            tmp[j] = d_star[j] + ray_b * v_star[j]
             rhs[j] = 0.0
-        csr_matvec_add(basis.k_ptr, basis.k_ind, basis.k_dat, tmp, rhs, -ca)
-        csr_matvec_add(basis.m_ptr, basis.m_ind, basis.m_dat, v_star, rhs, -ca * basis.ray_a)
+        csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, -ca)
+        csr_matvec_add(m_ptr, m_ind, m_dat, v_star, rhs, -ca * ray_a)
         if alpha != 0.0:
             for j in range(n):
-                tmp[j] = state.d[j] + basis.ray_b * state.v[j]
-                rhs[j] -= alpha * state.force[j]
-            csr_matvec_add(basis.k_ptr, basis.k_ind, basis.k_dat, tmp, rhs, alpha)
-            csr_matvec_add(basis.m_ptr, basis.m_ind, basis.m_dat, state.v, rhs, alpha * basis.ray_a)
+                tmp[j] = d[j] + ray_b * v[j]
+                rhs[j] -= alpha * force[j]
+            csr_matvec_add(k_ptr, k_ind, k_dat, tmp, rhs, alpha)
+            csr_matvec_add(m_ptr, m_ind, m_dat, v, rhs, alpha * ray_a)
     else:
         for j in range(n):
-            rhs[j] = -ca * (basis.c_diag[j] * v_star[j] + basis.k_diag[j] * d_star[j])
+            rhs[j] = -ca * (c_diag[j] * v_star[j] + k_diag[j] * d_star[j])
             if alpha != 0.0:
-                rhs[j] += alpha * (basis.c_diag[j] * state.v[j] + basis.k_diag[j] * state.d[j] - state.force[j])
+                rhs[j] += alpha * (c_diag[j] * v[j] + k_diag[j] * d[j] - force[j])
 
 
 @compiled
-def _physical_rows(basis, deck, elems, vals, idx, rv):  # noqa: ANN001, ANN201
+def _physical_rows(reduced, dofs, node_dofs, elems, vals, idx, rv):  # noqa: ANN001, ANN201
     """Contact rows at the few reduced DOFs a deck point depends on (-1: restrained or off the deck)."""
-    dofs = deck.dofs
     for i in range(elems.shape[0]):
         e = elems[i]
         for kk in range(dofs.shape[0]):
             k = dofs[kk]
-            idx[i, kk] = basis.reduced[deck.node_dofs * e + k] if e >= 0 else -1
+            idx[i, kk] = reduced[node_dofs * e + k] if e >= 0 else -1
             rv[i, 0, kk] = vals[i, 0, k]
             rv[i, 1, kk] = vals[i, 1, k]
             rv[i, 2, kk] = vals[i, 2, k]
@@ -277,14 +272,20 @@ def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa
     (``basis.inverse`` given) also keeps the physical rows (``pidx``, ``prv``)
     for the capacitance matrix.
     """
+    _project_rows(basis.kind, basis.reduced, deck.dofs, deck.node_dofs, basis.inverse.shape[0] > 0, basis.n,
+                  basis.poly_w, basis.poly_t, elems, vals, geo, idx, rv, pidx, prv)
+
+
+@compiled(inline=True)
+def _project_rows(kind, reduced, dofs, node_dofs, physical, m, pw, pt, elems, vals, geo, idx, rv, pidx, prv):  # noqa: ANN001, ANN201, E501
+    """:func:`project_contacts` on the arrays themselves (for the block loop: see :func:`_element_rows`);
+    ``physical``: the physical rows are kept too (a complete modal engine); ``m``: the modes."""
     q = elems.shape[0]
-    if basis.kind == DIRECT:
-        _physical_rows(basis, deck, elems, vals, idx, rv)
+    if kind == DIRECT:
+        _physical_rows(reduced, dofs, node_dofs, elems, vals, idx, rv)
     else:
-        if basis.inverse.shape[0] > 0:
-            _physical_rows(basis, deck, elems, vals, pidx, prv)
-        m = basis.n
-        pw, pt = basis.poly_w, basis.poly_t
+        if physical:
+            _physical_rows(reduced, dofs, node_dofs, elems, vals, pidx, prv)
         for i in range(q):
             e = elems[i]
             if e < 0:
@@ -307,24 +308,26 @@ def project_contacts(basis, deck, elems, vals, geo, idx, rv, pidx, prv):  # noqa
 
 
 @compiled(inline=True)
-def solve(basis, b, x, counters):  # noqa: ANN001, ANN201
-    """x = A^{-1} b with the once-factorised effective matrix (banded Cholesky, or a modal basis' diagonal)."""
-    if basis.kind == DIRECT:
+def solve(kind, factor, a_inv, b, x, counters):  # noqa: ANN001, ANN201
+    """x = A^{-1} b with the once-factorised effective matrix (banded Cholesky ``factor``, or a modal basis'
+    diagonal inverse ``a_inv``)."""
+    if kind == DIRECT:
         counters[2] += 1
-        band_solve_into(basis.factor, b, x)
+        band_solve_into(factor, b, x)
     else:
         for j in range(b.shape[0]):
-            x[j] = b[j] * basis.a_inv[j]
+            x[j] = b[j] * a_inv[j]
 
 
 @compiled
-def _mix_groups(groups, S, pz):  # noqa: ANN001, ANN201
-    """Rows of a multi-contact vehicle: S <- I + H S~ and pz <- H pz~ with its coupling matrix H."""
+def _mix_groups(first_of, ncont, aoff, nzs, aux, S, pz):  # noqa: ANN001, ANN201
+    """Rows of a multi-contact vehicle: S <- I + H S~ and pz <- H pz~ with its coupling matrix H (the groups'
+    arrays of :data:`GroupArrays`: ``first``, ``ncont``, ``aoff``, ``nz``, ``aux``)."""
     q = S.shape[0]
-    for g in range(groups.first.shape[0]):
-        first, nc = groups.first[g], groups.ncont[g]
-        a0 = groups.aoff[g]
-        nz = groups.nz[g]
+    for g in range(first_of.shape[0]):
+        first, nc = first_of[g], ncont[g]
+        a0 = aoff[g]
+        nz = nzs[g]
         h0 = a0 + nz + nz * nc + nc
         rows = S[first:first + nc, :].copy()
         pzs = pz[first:first + nc].copy()
@@ -332,21 +335,22 @@ def _mix_groups(groups, S, pz):  # noqa: ANN001, ANN201
             for c in range(q):
                 s = 1.0 if first + k == c else 0.0
                 for m in range(nc):
-                    s += groups.aux[h0 + k * nc + m] * rows[m, c]
+                    s += aux[h0 + k * nc + m] * rows[m, c]
                 S[first + k, c] = s
             s = 0.0
             for m in range(nc):
-                s += groups.aux[h0 + k * nc + m] * pzs[m]
+                s += aux[h0 + k * nc + m] * pzs[m]
             pz[first + k] = s
 
 
 @compiled
-def _capacitance(ainv, idx, rv, p, groups, S):  # noqa: ANN001, ANN201
-    """S = I + P A^-1 U^T from the entries of the dense physical inverse at the rows' few DOFs."""
+def _capacitance(ainv, idx, rv, p, col, S):  # noqa: ANN001, ANN201
+    """S = I + P A^-1 U^T from the entries of the dense physical inverse at the rows' few DOFs (``col``: each
+    column's vehicle group, -1 for a one-contact model: :data:`GroupArrays`)."""
     q, nnz = idx.shape
     for i in range(q):
         for jv in range(q):
-            s = 1.0 if i == jv and groups.col[i] < 0 else 0.0
+            s = 1.0 if i == jv and col[i] < 0 else 0.0
             for kk in range(nnz):
                 r_ = idx[i, kk]
                 if r_ < 0:
@@ -361,17 +365,19 @@ def _capacitance(ainv, idx, rv, p, groups, S):  # noqa: ANN001, ANN201
 
 
 @compiled
-def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pidx, prv, pp):  # noqa: ANN001, ANN201
+def woodbury(kind, inverse, factor, a_inv, idx, rv, p, z_b, S, pz, us, corr, counters, col, first, ncont, aoff, nz,  # noqa: ANN001, ANN201
+             aux, coef, pidx, prv, pp):
     """z_b <- (A + U P^T)^{-1} b from z_b = A^{-1} b: the rank-q update (docs/theory.md §6.6, (6.14)-(6.16)).
 
     Capacitance matrix ``S = I + P A^-1 U^T``: on the direct basis from the
     dense inverse's entries at the rows' few unknowns (no solve per vehicle);
     on a modal basis A is diagonal (a complete modal engine uses the physical
     inverse's entries instead: 64 products per pair rather than one per mode).
-    ``coef`` holds the rows' c0, c1, c2.
+    ``coef`` holds the rows' c0, c1, c2. The basis' and the vehicle groups' arrays come one by one, not in
+    their named tuples (see :func:`advance_block`).
     """
     q, nnz = idx.shape
-    if basis.kind == DIRECT:
+    if kind == DIRECT:
         for i in range(q):
             s = 0.0
             for kk in range(nnz):
@@ -379,8 +385,9 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
                 if j >= 0:
                     s += p[i, kk] * z_b[j]
             pz[i] = s
-        _capacitance(basis.inverse, idx, rv, p, groups, S)
-        _mix_groups(groups, S, pz)
+        _capacitance(inverse, idx, rv, p, col, S)
+        if first.shape[0] > 0:
+            _mix_groups(first, ncont, aoff, nz, aux, S, pz)
         solve_small(S, pz)  # pz <- S^-1 pz
         for j in range(us.shape[0]):
             us[j] = 0.0
@@ -389,31 +396,31 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
                 j = idx[i, kk]
                 if j >= 0:
                     us[j] += rv[i, 0, kk] * pz[i]
-        band_solve_into(basis.factor, us, corr)
+        band_solve_into(factor, us, corr)
         counters[2] += 1
         for j in range(z_b.shape[0]):
             z_b[j] -= corr[j]
     else:
-        m = basis.n
-        a_inv = basis.a_inv
+        m = a_inv.shape[0]
         for i in range(q):
             s = 0.0
             for j in range(m):
                 s += p[i, j] * z_b[j]
             pz[i] = s
-        if basis.inverse.shape[0] > 0:
+        if inverse.shape[0] > 0:
             for i in range(q):
                 for kk in range(pidx.shape[1]):
                     pp[i, kk] = coef[0, i] * prv[i, 0, kk] + coef[1, i] * prv[i, 1, kk] + coef[2, i] * prv[i, 2, kk]
-            _capacitance(basis.inverse, pidx, prv, pp, groups, S)
+            _capacitance(inverse, pidx, prv, pp, col, S)
         else:
             for i in range(q):
                 for k in range(q):
-                    s = 1.0 if i == k and groups.col[i] < 0 else 0.0
+                    s = 1.0 if i == k and col[i] < 0 else 0.0
                     for j in range(m):
                         s += p[i, j] * (a_inv[j] * rv[k, 0, j])
                     S[i, k] = s
-        _mix_groups(groups, S, pz)
+        if first.shape[0] > 0:
+            _mix_groups(first, ncont, aoff, nz, aux, S, pz)
         solve_small(S, pz)  # pz <- S^-1 pz
         for j in range(m):
             c = 0.0
@@ -424,51 +431,47 @@ def woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, counters, groups, coef, pi
 
 # --------------------------------------------------------- vehicle physics
 @compiled(inline=True)
-def vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups):  # noqa: ANN001, ANN201
-    """Every vehicle's predictors and deck-force coefficients: ``E_i = e0_i - (c0 n0 + c1 n1 + c2 n2)_i . a``."""
-    dt, beta, gamma, alpha = scheme.dt, scheme.beta, scheme.gamma, scheme.alpha
+def vehicle_coefficients(kinds, params, vstate, weight, kv, ka, kr, krx, step, dots, dt, beta, gamma, alpha, e0, c0,  # noqa: ANN001, ANN201, E501
+                         c1, c2, pred, aux):
+    """Every one-contact vehicle's predictors and deck-force coefficients: ``E_i = e0_i - (c0 n0 + c1 n1 + c2
+    n2)_i . a``; the fleet's and the block's arrays one by one (see :func:`advance_block`). Linear vehicles
+    (``LINEAR``) are left to :func:`cosim.core.vehicles.linear.group_coefficients`, a whole vehicle at once."""
     ca = 1.0 + alpha
     b2, g1 = beta * dt * dt, gamma * dt
-    vstate = fleet.vstate
-    for i in range(fleet.kind.shape[0]):
-        kind = fleet.kind[i]
-        if kind == LINEAR:  # the whole vehicle at its first column (its later columns are filled then)
-            if i == groups.first[groups.col[i]]:
-                linear.group_coefficients(groups.col[i], groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2)
+    for i in range(kinds.shape[0]):
+        kind = kinds[i]
+        if kind == LINEAR:
             continue
         pred[0, i] = vstate[0, i] + dt * vstate[1, i] + (0.5 - beta) * dt * dt * vstate[2, i]
         pred[1, i] = vstate[1, i] + (1.0 - gamma) * dt * vstate[2, i]
         pred[2, i] = vstate[3, i] + dt * vstate[4, i] + (0.5 - beta) * dt * dt * vstate[5, i]
         pred[3, i] = vstate[4, i] + (1.0 - gamma) * dt * vstate[5, i]
-        e0[i] = -ca * fleet.weight[i]
+        e0[i] = -ca * weight[i]
         c0[i] = 0.0
         c1[i] = 0.0
         c2[i] = 0.0
-        v, a, r, r_x = kin.v[step, i], kin.a[step, i], kin.r[step, i], kin.r_x[step, i]
+        v, a, r, r_x = kv[step, i], ka[step, i], kr[step, i], krx[step, i]
         if kind == QUARTER_CAR:
-            quarter_car.coefficients(i, fleet.params, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha,
+            quarter_car.coefficients(i, params, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha,
                                      e0, c0, c1, c2, aux)
         elif kind == TYRE_QUARTER_CAR:
-            tyre_quarter_car.coefficients(i, fleet.params, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha,
+            tyre_quarter_car.coefficients(i, params, vstate, pred, v, a, r, r_x, dots, b2, g1, ca, alpha,
                                           e0, c0, c1, c2, aux)
 
 
 @compiled(inline=True)
-def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups):  # noqa: ANN001, ANN201
-    """Advance the vehicles once the bridge acceleration is known; fills contact forces (N, compression
-    positive) and the non-inertial deck forces (the HHT F_{n+1})."""
-    dt, beta, gamma, alpha = scheme.dt, scheme.beta, scheme.gamma, scheme.alpha
+def vehicle_update(kinds, params, vstate, weight, kv, ka, step, dots, dt, beta, gamma, alpha, pred, aux, contact,  # noqa: ANN001, ANN201, E501
+                   weighted):
+    """Advance the one-contact vehicles once the bridge acceleration is known; fills contact forces (N,
+    compression positive) and the non-inertial deck forces (the HHT F_{n+1}). Linear vehicles are left to
+    :func:`cosim.core.vehicles.linear.group_update`."""
     ca = 1.0 + alpha
     b2, g1 = beta * dt * dt, gamma * dt
-    vstate = fleet.vstate
-    for i in range(fleet.kind.shape[0]):
-        kind = fleet.kind[i]
-        if kind == LINEAR:  # the whole vehicle at its first column
-            g = groups.col[i]
-            if i == groups.first[g]:
-                linear.group_update(g, groups, fleet, kin, step, dots, scheme, vstate, contact, weighted)
+    for i in range(kinds.shape[0]):
+        kind = kinds[i]
+        if kind == LINEAR:
             continue
-        v, a = kin.v[step, i], kin.a[step, i]
+        v, a = kv[step, i], ka[step, i]
         n0a, n1a, n2a = dots[5, i], dots[6, i], dots[7, i]
         acc_b = 0.0
         acc_w = 0.0
@@ -478,11 +481,11 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted,
         elastic = 0.0
         if kind == QUARTER_CAR:
             acc_b, acc_w, susp, tyre, part, elastic = quarter_car.update(
-                i, fleet.params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
+                i, params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
         elif kind == TYRE_QUARTER_CAR:
             acc_b, acc_w, susp, tyre, part, elastic = tyre_quarter_car.update(
-                i, fleet.params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
-        deck = -fleet.weight[i] + part
+                i, params, vstate, aux, v, a, n0a, n1a, n2a, b2, g1, ca, alpha)
+        deck = -weight[i] + part
         vstate[0, i] = pred[0, i] + b2 * acc_b
         vstate[1, i] = pred[1, i] + g1 * acc_b
         vstate[2, i] = acc_b
@@ -498,7 +501,7 @@ def vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted,
         contact[i] = -deck
         # The HHT F_{n+1}: weight and the elastic force on the deck, not the wheel's inertia
         # (docs/theory.md (6.5)): the suspension for rigid contact, the tyre for a tyre quarter-car.
-        weighted[i] = -fleet.weight[i] + elastic if kind != MOVING_FORCE else -fleet.weight[i]
+        weighted[i] = -weight[i] + elastic if kind != MOVING_FORCE else -weight[i]
 
 
 # ------------------------------------------------------------------- shared
@@ -516,22 +519,22 @@ def _newmark_update(d, v, a, d_star, v_star, acc, b2, g1):  # noqa: ANN001, ANN2
 
 
 @compiled(inline=True)
-def _record(step, elems, contact, fleet, groups, out):  # noqa: ANN001, ANN201
-    """The step's vehicle outputs, and lift-off: the one place where it is detected and counted (theory §5.7)."""
-    counters = out.counters
+def _record(step, elems, contact, vstate, lifted, flying, on_, contact_, body_u, body_a, lifted_, counters):  # noqa: ANN001, ANN201, E501
+    """The step's vehicle outputs (``on_``, ``contact_``, ``body_u``, ``body_a``, ``lifted_``: the block's
+    :data:`BlockOutputs`), and lift-off: the one place where it is detected and counted (theory §5.7)."""
     for i in range(elems.shape[0]):
         on = elems[i] >= 0
-        out.on[step, i] = on
-        out.contact[step, i] = contact[i] if on else 0.0
-        out.body_u[step, i] = fleet.vstate[0, i]
-        out.body_a[step, i] = fleet.vstate[2, i]
-        now = on and (contact[i] < 0.0 or groups.flying[i])
-        out.lifted[step, i] = now
+        on_[step, i] = on
+        contact_[step, i] = contact[i] if on else 0.0
+        body_u[step, i] = vstate[0, i]
+        body_a[step, i] = vstate[2, i]
+        now = on and (contact[i] < 0.0 or flying[i])
+        lifted_[step, i] = now
         if now:
             counters[1] += 1
-            if not fleet.lifted[i]:
+            if not lifted[i]:
                 counters[0] += 1
-        fleet.lifted[i] = now
+        lifted[i] = now
 
 
 @compiled(inline=True)
@@ -618,26 +621,58 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     bs = np.empty((3, 4))
     br = np.empty((3, 4))
     cell = np.empty((3, 4, 4))
-    for step in range(kin.x.shape[0]):
+    # The arrays the steps read, taken out of their named tuples once: an inlined function that takes a named
+    # tuple costs a reference count on every array in it at every call (hundreds per step, most of a step's time).
+    kind, deck_kind, physical = basis.kind, deck.kind, basis.inverse.shape[0] > 0
+    nodes_x, cw, ct, dofs, reduced, poly_w, poly_t = deck.nodes_x, deck.cw, deck.ct, deck.dofs, basis.reduced, \
+        basis.poly_w, basis.poly_t
+    y_s, length, node_dofs, y_lo, y_hi = deck.y_s, deck.length, deck.node_dofs, deck.y_lo, deck.y_hi
+    kx, kv, ky = kin.x, kin.v, kin.y
+    inverse, factor, a_inv, counters = basis.inverse, basis.factor, basis.a_inv, out.counters
+    g_col, g_first, g_ncont, g_aoff, g_nz, g_aux = groups.col, groups.first, groups.ncont, groups.aoff, groups.nz, \
+        groups.aux
+    unilateral, flying = groups.unilateral, groups.flying
+    k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat = basis.k_ptr, basis.k_ind, basis.k_dat, basis.m_ptr, basis.m_ind, \
+        basis.m_dat
+    ray_a, ray_b, c_diag, k_diag = basis.ray_a, basis.ray_b, basis.c_diag, basis.k_diag
+    kinds, params, vstate, weight, lifted = fleet.kind, fleet.params, fleet.vstate, fleet.weight, fleet.lifted
+    ka, kr, krx = kin.a, kin.r, kin.r_x
+    out_on, out_contact, out_body_u, out_body_a, out_lifted = out.on, out.contact, out.body_u, out.body_a, out.lifted
+    s_idx, s_vals, s_order, s_every, s_step0, out_sensors = sensors.idx, sensors.vals, sensors.order, sensors.every, \
+        sensors.step0, out.sensors
+    for step in range(kx.shape[0]):
         for j in range(n):
             d_star[j] = d[j] + dt * v[j] + (0.5 - beta) * dt * dt * a[j]
             v_star[j] = v[j] + (1.0 - gamma) * dt * a[j]
-        internal_rhs(basis, state, d_star, v_star, tmp, rhs, ca, alpha)
-        deck_rows(basis, deck, kin, step, elems, vals, geo, idx, rv, pidx, prv, bs, br, cell)
+        internal_rhs(kind, k_ptr, k_ind, k_dat, m_ptr, m_ind, m_dat, ray_a, ray_b, c_diag, k_diag, d, v, force, d_star,
+                     v_star, tmp, rhs, ca, alpha)
+        # The deck seam: every contact point's rows in the basis' coordinates (idx, rv) and where it is (elems[i]
+        # < 0: off the deck). A beam deck evaluates its elements' cubics at the points and projects them on the
+        # basis; a deck given by its modes gives the rows in its modal coordinates directly (surface_rows).
+        if q > 0:
+            if deck_kind == SURFACE_DECK:
+                surface_rows(kin, step, deck, elems, rv, bs, br, cell)
+            else:
+                _element_rows(kx[step], ky, kv[step], nodes_x, cw, ct, y_s, length, y_lo, y_hi, elems, vals, geo)
+                _project_rows(kind, reduced, dofs, node_dofs, physical, n, poly_w, poly_t, elems, vals, geo, idx, rv,
+                              pidx, prv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
         for i in range(q):
-            s0, s1, s3, s2, s4, _ = _deck_dots(basis.kind, idx, rv, i, nnz, d_star, v_star, v_star, False)
+            s0, s1, s3, s2, s4, _ = _deck_dots(kind, idx, rv, i, nnz, d_star, v_star, v_star, False)
             dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = s0, s1, s2, s3, s4
-        if groups.unilateral:
+        if unilateral:
             for j in range(n):
                 rhs_bridge[j] = rhs[j]
         for attempt in range(MAX_CONTACT_SWITCHES + 1):
             if attempt > 0:
                 for j in range(n):
                     rhs[j] = rhs_bridge[j]
-            vehicle_coefficients(fleet, kin, step, dots, scheme, e0, c0, c1, c2, pred, aux, groups)
+            vehicle_coefficients(kinds, params, vstate, weight, kv, ka, kr, krx, step, dots, dt, beta, gamma, alpha, e0,
+                                 c0, c1, c2, pred, aux)
+            for g in range(g_first.shape[0]):  # linear vehicles, each whole at its first column
+                linear.group_coefficients(g, groups, fleet, kin, step, dots, scheme, e0, c0, c1, c2)
             for i in range(q):
-                if basis.kind == MODAL:
+                if kind == MODAL:
                     for j in range(nnz):
                         p[i, j] = c0[i] * rv[i, 0, j] + c1[i] * rv[i, 1, j] + c2[i] * rv[i, 2, j]
                         rhs[j] += rv[i, 0, j] * e0[i]
@@ -647,12 +682,14 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                     p[i, kk] = c0[i] * rv[i, 0, kk] + c1[i] * rv[i, 1, kk] + c2[i] * rv[i, 2, kk]
                     if j >= 0:
                         rhs[j] += rv[i, 0, kk] * e0[i]
-            solve(basis, rhs, z_b, out.counters)
+            solve(kind, factor, a_inv, rhs, z_b, counters)
             if q > 0:
                 for i in range(q):
                     coef[0, i], coef[1, i], coef[2, i] = c0[i], c1[i], c2[i]
-                woodbury(basis, idx, rv, p, z_b, S, pz, us, corr, out.counters, groups, coef, pidx, prv, pp)
-            if not groups.unilateral or attempt == MAX_CONTACT_SWITCHES:
+                woodbury(kind, inverse, factor, a_inv, idx, rv, p, z_b, S, pz, us, corr, counters, g_col, g_first,
+                         g_ncont,
+                         g_aoff, g_nz, g_aux, coef, pidx, prv, pp)
+            if not unilateral or attempt == MAX_CONTACT_SWITCHES:
                 break
             # Unilateral contact: does the trial step agree with the contact states it assumed?
             for i in range(q):
@@ -664,24 +701,27 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                         s1 += rv[i, 1, kk] * z_b[j]
                 tau0[i], tau1[i] = s0, s1
                 w_end[i] = dots[0, i] + b2 * s0
-                wd_end[i] = dots[2, i] + g1 * s0 + kin.v[step, i] * (dots[1, i] + b2 * s1)
+                wd_end[i] = dots[2, i] + g1 * s0 + kv[step, i] * (dots[1, i] + b2 * s1)
             changed = False
-            for g in range(groups.first.shape[0]):
+            for g in range(g_first.shape[0]):
                 if linear.group_check(g, groups, fleet, kin, step, tau0, tau1, w_end, wd_end, scheme):
                     changed = True
             if not changed:
                 break
-        if basis.kind == MODAL:
-            out.counters[2] += 1  # one (diagonal) solve per step, with or without vehicles
+        if kind == MODAL:
+            counters[2] += 1  # one (diagonal) solve per step, with or without vehicles
         if not _newmark_update(d, v, a, d_star, v_star, z_b, b2, g1):
-            out.counters[3] = step + 1
+            counters[3] = step + 1
             return
         # Deck motion at the contact points after the step: n0.a, n1.a, n2.a, n0.d, n0.v + v n1.d.
         for i in range(q):
-            s0, s1, s2, s3, s5, s4 = _deck_dots(basis.kind, idx, rv, i, nnz, a, d, v, True)
+            s0, s1, s2, s3, s5, s4 = _deck_dots(kind, idx, rv, i, nnz, a, d, v, True)
             dots[5, i], dots[6, i], dots[7, i], dots[8, i] = s0, s1, s2, s3
-            dots[9, i] = s4 + kin.v[step, i] * s5
-        vehicle_update(fleet, kin, step, dots, scheme, pred, aux, contact, weighted, groups)
+            dots[9, i] = s4 + kv[step, i] * s5
+        vehicle_update(kinds, params, vstate, weight, kv, ka, step, dots, dt, beta, gamma, alpha, pred, aux, contact,
+                       weighted)
+        for g in range(g_first.shape[0]):  # linear vehicles, each whole at its first column
+            linear.group_update(g, groups, fleet, kin, step, dots, scheme, vstate, contact, weighted)
         if alpha != 0.0:
             for j in range(n):
                 force[j] = 0.0
@@ -690,17 +730,18 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                     j = idx[i, kk]
                     if j >= 0:
                         force[j] += rv[i, 0, kk] * weighted[i]
-        _record(step, elems, contact, fleet, groups, out)
-        for s_ in range(sensors.idx.shape[0]):
-            every = sensors.every[s_]
-            if every > 1 and (sensors.step0[0] + step) % every != 0:
-                out.sensors[step, s_] = np.nan
+        _record(step, elems, contact, vstate, lifted, flying, out_on, out_contact, out_body_u, out_body_a, out_lifted,
+                counters)
+        for s_ in range(s_idx.shape[0]):
+            every = s_every[s_]
+            if every > 1 and (s_step0[0] + step) % every != 0:
+                out_sensors[step, s_] = np.nan
                 continue
-            order = sensors.order[s_]
+            order = s_order[s_]
             src = d if order == 0 else (v if order == 1 else a)
             acc_ = 0.0
-            for k in range(sensors.idx.shape[1]):
-                j = sensors.idx[s_, k]
+            for k in range(s_idx.shape[1]):
+                j = s_idx[s_, k]
                 if j >= 0:
-                    acc_ += sensors.vals[s_, k] * src[j]
-            out.sensors[step, s_] = acc_
+                    acc_ += s_vals[s_, k] * src[j]
+            out_sensors[step, s_] = acc_
