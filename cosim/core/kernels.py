@@ -22,7 +22,11 @@ effective matrix) and :func:`woodbury` (the vehicles' rank-q correction).
 
 Vehicle physics is dispatched per vehicle on its model's ``KIND``
 (:mod:`cosim.core.vehicles`). Arrays reach the loop grouped in named tuples;
-every buffer is allocated once per block, not per step. The loop releases
+the loop takes them out once per block and hands each helper it calls at
+every step only the arrays it reads: numba counts a reference on every array
+of a tuple each time a function takes it, and those counts were a third of
+a step (benchmarks/README.md, "Where the time goes"). Every buffer is
+allocated once per block, not per step. The loop releases
 the GIL, so a log writer thread can encode one block while the next is
 computed.
 """
