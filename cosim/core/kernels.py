@@ -542,32 +542,34 @@ def _record(step, elems, contact, vstate, lifted, flying, on_, contact_, body_u,
 
 
 @compiled(inline=True)
-def _deck_dots(kind, idx, rv, i, nnz, u, w, z, with_z):  # noqa: ANN001, ANN201
-    """Contact row i (w, w_x, w_xx: ``rv[i]``) against basis vectors: n0.u, n1.u, n2.u, n0.w, n1.w and, with
-    ``with_z``, n0.z, in one pass over the row. On a modal basis the row holds every mode in order (no index to
-    follow: the loop vectorises); on the direct basis ``idx[i]`` names the unknowns (-1: restrained)."""
-    s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-    if kind == MODAL:
-        for j in range(nnz):
-            s0 += rv[i, 0, j] * u[j]
-            s1 += rv[i, 1, j] * u[j]
-            s2 += rv[i, 2, j] * u[j]
-            s3 += rv[i, 0, j] * w[j]
-            s4 += rv[i, 1, j] * w[j]
-            if with_z:
-                s5 += rv[i, 0, j] * z[j]
-    else:
-        for kk in range(nnz):
-            j = idx[i, kk]
-            if j >= 0:
-                s0 += rv[i, 0, kk] * u[j]
-                s1 += rv[i, 1, kk] * u[j]
-                s2 += rv[i, 2, kk] * u[j]
-                s3 += rv[i, 0, kk] * w[j]
-                s4 += rv[i, 1, kk] * w[j]
+def _deck_dots(kind, idx, rv, nnz, u, w, z, with_z, out):  # noqa: ANN001, ANN201
+    """Every contact row (w, w_x, w_xx: ``rv[i]``) against basis vectors: ``out[:, i]`` = n0.u, n1.u, n2.u, n0.w,
+    n1.w and, with ``with_z``, n0.z, in one pass over each row (one call for all rows: a call per row cost the
+    step a reference count on each of its arrays). On a modal basis the row holds every mode in order (no index
+    to follow: the loop vectorises); on the direct basis ``idx[i]`` names the unknowns (-1: restrained)."""
+    for i in range(rv.shape[0]):
+        s0 = s1 = s2 = s3 = s4 = s5 = 0.0
+        if kind == MODAL:
+            for j in range(nnz):
+                s0 += rv[i, 0, j] * u[j]
+                s1 += rv[i, 1, j] * u[j]
+                s2 += rv[i, 2, j] * u[j]
+                s3 += rv[i, 0, j] * w[j]
+                s4 += rv[i, 1, j] * w[j]
                 if with_z:
-                    s5 += rv[i, 0, kk] * z[j]
-    return s0, s1, s2, s3, s4, s5
+                    s5 += rv[i, 0, j] * z[j]
+        else:
+            for kk in range(nnz):
+                j = idx[i, kk]
+                if j >= 0:
+                    s0 += rv[i, 0, kk] * u[j]
+                    s1 += rv[i, 1, kk] * u[j]
+                    s2 += rv[i, 2, kk] * u[j]
+                    s3 += rv[i, 0, kk] * w[j]
+                    s4 += rv[i, 1, kk] * w[j]
+                    if with_z:
+                        s5 += rv[i, 0, kk] * z[j]
+        out[0, i], out[1, i], out[2, i], out[3, i], out[4, i], out[5, i] = s0, s1, s2, s3, s4, s5
 
 
 @compiled(nogil=True)
@@ -594,6 +596,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     contact = np.empty(q)
     weighted = np.empty(q)
     dots = np.zeros((10, q))
+    sums = np.empty((6, q))
     e0 = np.empty(q)
     c0 = np.empty(q)
     c1 = np.empty(q)
@@ -661,9 +664,10 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                 _project_rows(kind, reduced, dofs, node_dofs, physical, n, poly_w, poly_t, elems, vals, geo, idx, rv,
                               pidx, prv)
         # Deck motion at the contact points from the predictors: n0.d*, n1.d*, n0.v*, n2.d*, n1.v*.
+        _deck_dots(kind, idx, rv, nnz, d_star, v_star, v_star, False, sums)
         for i in range(q):
-            s0, s1, s3, s2, s4, _ = _deck_dots(kind, idx, rv, i, nnz, d_star, v_star, v_star, False)
-            dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = s0, s1, s2, s3, s4
+            dots[0, i], dots[1, i], dots[2, i], dots[3, i], dots[4, i] = sums[0, i], sums[1, i], sums[3, i], \
+                sums[2, i], sums[4, i]
         if unilateral:
             for j in range(n):
                 rhs_bridge[j] = rhs[j]
@@ -718,10 +722,10 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
             counters[3] = step + 1
             return
         # Deck motion at the contact points after the step: n0.a, n1.a, n2.a, n0.d, n0.v + v n1.d.
+        _deck_dots(kind, idx, rv, nnz, a, d, v, True, sums)
         for i in range(q):
-            s0, s1, s2, s3, s5, s4 = _deck_dots(kind, idx, rv, i, nnz, a, d, v, True)
-            dots[5, i], dots[6, i], dots[7, i], dots[8, i] = s0, s1, s2, s3
-            dots[9, i] = s4 + kv[step, i] * s5
+            dots[5, i], dots[6, i], dots[7, i], dots[8, i] = sums[0, i], sums[1, i], sums[2, i], sums[3, i]
+            dots[9, i] = sums[5, i] + kv[step, i] * sums[4, i]
         vehicle_update(kinds, params, vstate, weight, kv, ka, step, dots, dt, beta, gamma, alpha, pred, aux, contact,
                        weighted)
         for g in range(g_first.shape[0]):  # linear vehicles, each whole at its first column

@@ -36,14 +36,6 @@ _on_deck = compiled(on_deck)
 
 
 @compiled(inline=True)
-def _on_surface(sf, x, y, s, r):  # noqa: ANN001, ANN201
-    """Whether the deck-frame point (x, y), at grid coordinates (s, r), lies on the deck's surface."""
-    if sf.rect:
-        return sf.s[0] - sf.tol <= s <= sf.s[-1] + sf.tol and sf.r[0] - sf.tol <= r <= sf.r[-1] + sf.tol
-    return point_in_triangles(sf.t_points, sf.t_tris, sf.t_lo, sf.t_size, sf.t_shape, sf.t_start, sf.t_items, x, y)
-
-
-@compiled(inline=True)
 def surface_rows(kin, step, deck, elems, rv, bs, br, coef):  # noqa: ANN001, ANN201
     """The contact rows of a deck given by its modes, in modal coordinates: ``rv[i]`` (3, m) = each mode's w,
     dw/dt and t^T H t + kappa n . grad w along the wheel's path (docs/theory.md §13.2); ``elems[i]`` = 0 on
@@ -52,21 +44,33 @@ def surface_rows(kin, step, deck, elems, rv, bs, br, coef):  # noqa: ANN001, ANN
     A contact point on a grid line where the slope jumps takes the cell ahead of it in its direction of
     travel, as the beam's rows take the element ahead (mirrored crossings see mirrored rows).
     """
+    # The surface's arrays taken out of their named tuple once: a function that takes a named tuple costs a
+    # reference count on every array in it at each call, and a call per contact point was most of a step's time.
     sf = deck.surface
+    sk, rk, rect, tol, snap, origin = sf.s, sf.r, sf.rect, sf.tol, sf.snap, sf.origin
+    w, w_s, w_s_minus, w_r, w_sr, w_sr_minus = sf.w, sf.w_s, sf.w_s_minus, sf.w_r, sf.w_sr, sf.w_sr_minus
+    t_points, t_tris, t_lo, t_size, t_shape, t_start, t_items = sf.t_points, sf.t_tris, sf.t_lo, sf.t_size, \
+        sf.t_shape, sf.t_start, sf.t_items
+    kx, kv, ky, path, length = kin.x, kin.v, kin.y, kin.path, deck.length
     a0, a1 = sf.axis[0], sf.axis[1]
-    ns = sf.s.shape[0]
-    with_path = kin.path.shape[0] > 0
+    ns = sk.shape[0]
+    with_path = path.shape[0] > 0
     for i in range(elems.shape[0]):
-        x = kin.x[step, i]
+        x = kx[step, i]
         if with_path:
-            y = kin.path[step, i, 0]
-            tx, ty, cx, cy = kin.path[step, i, 1], kin.path[step, i, 2], kin.path[step, i, 3], kin.path[step, i, 4]
+            y = path[step, i, 0]
+            tx, ty, cx, cy = path[step, i, 1], path[step, i, 2], path[step, i, 3], path[step, i, 4]
         else:
-            y, tx, ty, cx, cy = kin.y[i], 1.0, 0.0, 0.0, 0.0
-        dx, dy = x - sf.origin[0], y - sf.origin[1]
+            y, tx, ty, cx, cy = ky[i], 1.0, 0.0, 0.0, 0.0
+        dx, dy = x - origin[0], y - origin[1]
         s = dx * a0 + dy * a1
         r = -dx * a1 + dy * a0
-        if not (_on_deck(x, deck.length) and _on_surface(sf, x, y, s, r)):
+        # On the deck's surface: the grid's rectangle (within tol), or one of its triangles.
+        if rect:
+            on = sk[0] - tol <= s <= sk[-1] + tol and rk[0] - tol <= r <= rk[-1] + tol
+        else:
+            on = point_in_triangles(t_points, t_tris, t_lo, t_size, t_shape, t_start, t_items, x, y)
+        if not (_on_deck(x, length) and on):
             elems[i] = -1
             for o in range(3):
                 for j in range(rv.shape[2]):
@@ -75,14 +79,13 @@ def surface_rows(kin, step, deck, elems, rv, bs, br, coef):  # noqa: ANN001, ANN
         elems[i] = 0
         ts, tr = tx * a0 + ty * a1, -tx * a1 + ty * a0
         cs, cr = cx * a0 + cy * a1, -cx * a1 + cy * a0
-        e = np.searchsorted(sf.s, s, side="right") - 1
+        e = np.searchsorted(sk, s, side="right") - 1
         e = min(max(e, 0), ns - 2)
-        forward = ts * kin.v[step, i]
-        if forward < 0.0 and e > 0 and s - sf.s[e] <= sf.snap:
+        forward = ts * kv[step, i]
+        if forward < 0.0 and e > 0 and s - sk[e] <= snap:
             e -= 1  # on the line starting cell e, moving towards -s: the cell ahead is e - 1
-        elif forward >= 0.0 and e < ns - 2 and sf.s[e + 1] - s <= sf.snap:
+        elif forward >= 0.0 and e < ns - 2 and sk[e + 1] - s <= snap:
             e += 1
-        k = np.searchsorted(sf.r, r, side="right") - 1
-        k = min(max(k, 0), sf.r.shape[0] - 2)
-        cell_rows(sf.s, sf.r, sf.w, sf.w_s, sf.w_s_minus, sf.w_r, sf.w_sr, sf.w_sr_minus, e, k, s, r, ts, tr, cs, cr,
-                  bs, br, coef, rv[i])
+        k = np.searchsorted(rk, r, side="right") - 1
+        k = min(max(k, 0), rk.shape[0] - 2)
+        cell_rows(sk, rk, w, w_s, w_s_minus, w_r, w_sr, w_sr_minus, e, k, s, r, ts, tr, cs, cr, bs, br, coef, rv[i])
