@@ -628,8 +628,8 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
     bs = np.empty((3, 4))
     br = np.empty((3, 4))
     cell = np.empty((3, 4, 4))
-    # The arrays the steps read, taken out of their named tuples once: an inlined function that takes a named
-    # tuple costs a reference count on every array in it at every call (hundreds per step, most of a step's time).
+    # The arrays the steps read, taken out of their named tuples once: a function (inlined or not) that takes a
+    # named tuple costs a reference count on every array in it at every call (hundreds a step, a third of its time).
     kind, deck_kind, physical = basis.kind, deck.kind, basis.inverse.shape[0] > 0
     nodes_x, cw, ct, dofs, reduced, poly_w, poly_t = deck.nodes_x, deck.cw, deck.ct, deck.dofs, basis.reduced, \
         basis.poly_w, basis.poly_t
