@@ -695,8 +695,7 @@ def advance_block(basis, deck, scheme, state, fleet, kin, sensors, out, groups):
                 for i in range(q):
                     coef[0, i], coef[1, i], coef[2, i] = c0[i], c1[i], c2[i]
                 woodbury(kind, inverse, factor, a_inv, idx, rv, p, z_b, S, pz, us, corr, counters, g_col, g_first,
-                         g_ncont,
-                         g_aoff, g_nz, g_aux, coef, pidx, prv, pp)
+                         g_ncont, g_aoff, g_nz, g_aux, coef, pidx, prv, pp)
             if not unilateral or attempt == MAX_CONTACT_SWITCHES:
                 break
             # Unilateral contact: does the trial step agree with the contact states it assumed?

@@ -556,8 +556,8 @@ class SumoTraffic(LiveSumo):
         if done:
             done &= present  # a vehicle that left the watched lanes is forgotten
             present -= done
-        layout = self._layout
-        if present != self._watched:  # a vehicle came or went (most steps: the same vehicles as the step before)
+        same = present == self._watched  # most steps: the same vehicles as the step before
+        if not same:
             fixed = self._fixed
             veh = ls.vehicle
             for vid in present - self._watched:  # what does not change while it drives: read once
@@ -565,14 +565,11 @@ class SumoTraffic(LiveSumo):
             for vid in self._watched - present:
                 self._forget(vid)
             self._watched = present
-            if not present:
-                return Frame(t, (), _EMPTY, _EMPTY, _EMPTY, _EMPTY, ())
-            layout = self._layout
-            ids = tuple(sorted(present))
-        elif not present:
+        if not present:
             return Frame(t, (), _EMPTY, _EMPTY, _EMPTY, _EMPTY, ())
-        else:  # the same vehicles: the layout of the step before is theirs (any vehicle gone drops it)
-            ids = layout.vehicles if layout is not None else tuple(sorted(present))
+        layout = self._layout
+        # The same vehicles: the layout made for them at the step before is theirs (a vehicle gone drops it).
+        ids = layout.vehicles if same and layout is not None else tuple(sorted(present))
         trails = self._trails
         assert trails is not None
         position, angle, speed, acceleration = read.position, read.angle, read.speed, read.acceleration
@@ -604,8 +601,8 @@ class SumoTraffic(LiveSumo):
         if kept < contacts:  # one selection of the four rows, the names by a list of flags (not numpy's bools)
             keep = marks[:contacts]
             flags = keep.tolist()
-            axle_ids, axle_types = tuple(itertools.compress(axle_ids, flags)), tuple(itertools.compress(axle_types,
-                                                                                                       flags))
+            axle_ids = tuple(itertools.compress(axle_ids, flags))
+            axle_types = tuple(itertools.compress(axle_types, flags))
             xyva = xyva[:, keep]
         x, y, v, a = xyva
         return Frame(t, axle_ids, x, y, v, a, axle_types, loads)  # by position: a third cheaper than by keywords
